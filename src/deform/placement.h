@@ -1,0 +1,23 @@
+// A tool placement along a path: translation t, optional rotation (axis, angle in degrees)
+// and scale (uniform or per local axis). As a world-from-local matrix it is T(t) R S.
+#pragma once
+
+#include <Eigen/Geometry>
+
+namespace sweepers {
+
+struct Placement {
+    Eigen::Vector3d t = Eigen::Vector3d::Zero();
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+    double angleDegrees = 0.0;
+    Eigen::Vector3d scale = Eigen::Vector3d::Ones();
+
+    bool hasRotation() const { return angleDegrees != 0.0; }
+    bool uniformScale() const { return scale.x() == scale.y() && scale.y() == scale.z(); }
+    Eigen::Affine3d matrix() const;
+    bool operator==(const Placement& o) const {
+        return t == o.t && axis == o.axis && angleDegrees == o.angleDegrees && scale == o.scale;
+    }
+};
+
+} // namespace sweepers

@@ -1,0 +1,103 @@
+// Sweeps: one or several tools moved together along a path of placements, optionally
+// mirrored about a coordinate plane (thesis chapter 3, 5.3.3).
+//
+// A segment (one pair of consecutive placements) is split into s sub-steps by the
+// fold-over bound (3.14 for one tool, 3.19 for several). Sub-step k moves tool j by
+// M_j^(1/s), from placement tau_k = (k/s (.) M_j) X_j,A to tau_{k+1} (3.12, 3.13).
+//
+// The deformation is *defined* by its closed-form inverse (5.18, 5.19): the inverse of
+// sub-step k at p is exp(-c(p) sum_j phi_j(p) log(M_j)/s) . p with the influences phi_j of
+// the tools at tau_{k+1} and c = (1 - prod(1 - phi_j)) / sum(phi_j), the normalized blend
+// of 3.17 (c phi = phi for one tool). A segment's inverse applies the inverse sub-steps
+// last first; its forward map solves each sub-step by fixed-point iteration (INVERTFASTER,
+// 5.4.1 generalized to several tools).
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "core/box.h"
+#include "core/motion_log.h"
+#include "deform/placement.h"
+#include "tools/tool_shape.h"
+
+namespace sweepers {
+
+enum class MirrorAxis { None, X, Y, Z };
+
+struct SweptTool {
+    std::shared_ptr<const ToolShape> shape;
+    double falloff = 0.0; // lambda, world units
+    std::vector<Placement> path;
+};
+
+struct Sweep {
+    std::vector<SweptTool> tools;
+    MirrorAxis mirror = MirrorAxis::None;
+
+    // Number of segments; every tool must have the same number of placements (>= 2).
+    // Throws std::invalid_argument otherwise.
+    std::size_t segmentCount() const;
+};
+
+struct SegmentOptions {
+    int forceSteps = 0;              // > 0: use this many sub-steps instead of the bound
+    double forwardTolerance = 1e-12; // fixed-point convergence, relative to 1 + |p|
+    int forwardMaxIterations = 500;
+};
+
+struct ForwardResult {
+    Eigen::Vector3d p;
+    bool converged = true;
+    int iterations = 0; // largest count over the sub-steps
+};
+
+class SweepSegment {
+  public:
+    // Plans segment `index` of the sweep. Throws std::invalid_argument for a malformed
+    // sweep and std::domain_error for a motion without a logarithm.
+    SweepSegment(const Sweep& sweep, std::size_t index, const SegmentOptions& options = {});
+
+    int steps() const { return steps_; }
+    // The fold-over bound the step count was taken from (left side of 3.19).
+    double stepBound() const { return stepBound_; }
+    // Outside this box every sub-step, and so the whole segment, is the identity.
+    const Box& affectedBox() const { return affected_; }
+    // Tools after mirroring (a mirrored sweep has twice as many).
+    std::size_t toolCount() const { return tools_.size(); }
+    const MotionLog& motionLog(std::size_t tool) const { return tools_[tool].log; }
+
+    // Inverse of sub-step k (5.18 / 5.19).
+    Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const;
+    // Whole-segment inverse: inverse sub-steps s-1 down to 0.
+    Eigen::Vector3d inverseMap(const Eigen::Vector3d& p) const;
+    // Forward sub-step k: the p with inverseStep(k, p) = q.
+    ForwardResult forwardStep(int k, const Eigen::Vector3d& q) const;
+    // Whole-segment forward map: forward sub-steps 0 up to s-1.
+    ForwardResult forwardMap(const Eigen::Vector3d& p) const;
+
+    // Tool j at sub-step placement tau_k, k in [0, s].
+    const PlacedTool& placedTool(std::size_t j, int k) const { return *tools_[j].placed[k]; }
+
+  private:
+    struct ToolPlan {
+        MotionLog log;                                   // log M_j for the whole segment
+        MotionLog stepLog;                               // log M_j / s
+        std::vector<std::unique_ptr<PlacedTool>> placed; // k = 0..s
+    };
+    // Blended log of sub-step k at p (tools at tau_{k+1}); nullopt where no tool reaches.
+    std::optional<MotionLog> stepBlend(int k, const Eigen::Vector3d& p) const;
+
+    std::vector<ToolPlan> tools_;
+    std::vector<Box> stepBoxes_; // union of coatings at tau_{k+1}
+    Box affected_;
+    int steps_ = 1;
+    double stepBound_ = 0.0;
+    SegmentOptions options_;
+};
+
+// The reflection matrix of a mirror plane through the origin.
+Eigen::Matrix4d mirrorMatrix(MirrorAxis axis);
+
+} // namespace sweepers

@@ -1,0 +1,386 @@
+#include "io/stroke_script.h"
+
+#include <cmath>
+#include <fstream>
+#include <initializer_list>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "io/atomic_file.h"
+#include "tools/ellipsoid.h"
+
+namespace sweepers {
+
+using nlohmann::json;
+
+namespace {
+
+// Walks the JSON tree and knows where it is, so every complaint carries its location.
+class Reader {
+  public:
+    explicit Reader(const std::string& name) : name_(name) {}
+
+    [[noreturn]] void fail(const std::string& where, const std::string& why) const {
+        throw ScriptError(name_ + ": " + (where.empty() ? "/" : where) + ": " + why);
+    }
+
+    void onlyKeys(const json& obj, const std::string& where,
+                  std::initializer_list<const char*> allowed) const {
+        if (!obj.is_object()) fail(where, "expected an object");
+        for (auto it = obj.begin(); it != obj.end(); ++it) {
+            bool known = false;
+            for (const char* a : allowed)
+                known = known || it.key() == a;
+            if (!known) fail(where + "/" + it.key(), "unknown field");
+        }
+    }
+
+    const json& require(const json& obj, const std::string& where, const char* key) const {
+        auto it = obj.find(key);
+        if (it == obj.end()) fail(where + "/" + key, "missing field");
+        return *it;
+    }
+
+    double number(const json& v, const std::string& where) const {
+        if (!v.is_number()) fail(where, "expected a number, got " + describe(v));
+        const double d = v.get<double>();
+        if (!std::isfinite(d)) fail(where, "the number is not finite");
+        return d;
+    }
+
+    double positive(const json& v, const std::string& where) const {
+        const double d = number(v, where);
+        if (!(d > 0.0)) fail(where, "must be positive (got " + v.dump() + ")");
+        return d;
+    }
+
+    Eigen::Vector3d vec3(const json& v, const std::string& where) const {
+        if (!v.is_array() || v.size() != 3) fail(where, "expected an array of 3 numbers");
+        Eigen::Vector3d r;
+        for (int i = 0; i < 3; ++i)
+            r[i] = number(v[i], where + "/" + std::to_string(i));
+        return r;
+    }
+
+    std::string string(const json& v, const std::string& where) const {
+        if (!v.is_string()) fail(where, "expected a string, got " + describe(v));
+        return v.get<std::string>();
+    }
+
+    static std::string describe(const json& v) {
+        const std::string s = v.dump();
+        return s.size() > 40 ? s.substr(0, 37) + "..." : s;
+    }
+
+  private:
+    const std::string& name_;
+};
+
+Placement readPlacement(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"t", "r", "s"});
+    Placement p;
+    p.t = r.vec3(r.require(v, at, "t"), at + "/t");
+    if (auto it = v.find("r"); it != v.end()) {
+        if (!it->is_array() || it->size() != 4)
+            r.fail(at + "/r", "expected [axis x, axis y, axis z, angle in degrees]");
+        for (int i = 0; i < 3; ++i)
+            p.axis[i] = r.number((*it)[i], at + "/r/" + std::to_string(i));
+        p.angleDegrees = r.number((*it)[3], at + "/r/3");
+        if (p.axis.norm() == 0.0 && p.angleDegrees != 0.0)
+            r.fail(at + "/r", "the rotation axis is zero");
+        if (std::abs(p.angleDegrees) >= 360.0)
+            r.fail(at + "/r/3", "the angle must lie strictly between -360 and 360 degrees");
+    }
+    if (auto it = v.find("s"); it != v.end()) {
+        if (it->is_array()) {
+            p.scale = r.vec3(*it, at + "/s");
+            for (int i = 0; i < 3; ++i)
+                if (!(p.scale[i] > 0.0)) r.fail(at + "/s/" + std::to_string(i), "must be positive");
+        } else {
+            p.scale = Eigen::Vector3d::Constant(r.positive(*it, at + "/s"));
+        }
+    }
+    return p;
+}
+
+ToolSpec readTool(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"shape", "size", "falloff", "path"});
+    ToolSpec t;
+    t.shape = r.string(r.require(v, at, "shape"), at + "/shape");
+    const json& size = r.require(v, at, "size");
+    if (t.shape == "ball") {
+        t.size = Eigen::Vector3d::Constant(r.positive(size, at + "/size"));
+    } else if (t.shape == "ellipsoid") {
+        t.size = r.vec3(size, at + "/size");
+        for (int i = 0; i < 3; ++i)
+            if (!(t.size[i] > 0.0)) r.fail(at + "/size/" + std::to_string(i), "must be positive");
+    } else {
+        r.fail(at + "/shape", "unknown shape \"" + t.shape + "\" (expected ball or ellipsoid)");
+    }
+    t.falloff = r.positive(r.require(v, at, "falloff"), at + "/falloff");
+    const json& path = r.require(v, at, "path");
+    if (!path.is_array()) r.fail(at + "/path", "expected an array of placements");
+    if (path.size() < 2) r.fail(at + "/path", "a path needs at least two placements");
+    for (std::size_t i = 0; i < path.size(); ++i)
+        t.path.push_back(readPlacement(r, path[i], at + "/path/" + std::to_string(i)));
+    return t;
+}
+
+SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"type", "mirror", "tools"});
+    SweepStroke s;
+    if (auto it = v.find("mirror"); it != v.end()) {
+        const std::string m = r.string(*it, at + "/mirror");
+        if (m == "x")
+            s.mirror = MirrorAxis::X;
+        else if (m == "y")
+            s.mirror = MirrorAxis::Y;
+        else if (m == "z")
+            s.mirror = MirrorAxis::Z;
+        else
+            r.fail(at + "/mirror", "expected \"x\", \"y\" or \"z\"");
+    }
+    const json& tools = r.require(v, at, "tools");
+    if (!tools.is_array() || tools.empty())
+        r.fail(at + "/tools", "expected a non-empty array of tools");
+    for (std::size_t i = 0; i < tools.size(); ++i)
+        s.tools.push_back(readTool(r, tools[i], at + "/tools/" + std::to_string(i)));
+    for (std::size_t i = 1; i < s.tools.size(); ++i)
+        if (s.tools[i].path.size() != s.tools[0].path.size())
+            r.fail(at + "/tools/" + std::to_string(i) + "/path",
+                   "tools swept together need the same number of placements");
+
+    // Every segment's motion must have a logarithm and a sane number of sub-steps.
+    const Sweep sweep = toSweep(s);
+    for (std::size_t k = 0; k < sweep.segmentCount(); ++k) {
+        try {
+            SweepSegment segment(sweep, k);
+        } catch (const std::exception& e) {
+            r.fail(at + "/tools/0/path/" + std::to_string(k + 1),
+                   std::string("segment ") + std::to_string(k) + ": " + e.what());
+        }
+    }
+    return s;
+}
+
+SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"type", "at", "move", "radius", "ring", "swirls"});
+    SwirlStroke s;
+    s.at = r.vec3(r.require(v, at, "at"), at + "/at");
+    s.move = r.vec3(r.require(v, at, "move"), at + "/move");
+    s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
+    if (auto it = v.find("ring"); it != v.end()) {
+        s.ring = r.string(*it, at + "/ring");
+        if (s.ring != "discrete" && s.ring != "convolution")
+            r.fail(at + "/ring", "expected \"discrete\" or \"convolution\"");
+    }
+    if (auto it = v.find("swirls"); it != v.end()) {
+        if (!it->is_number_integer() || it->get<long long>() < 1 || it->get<long long>() > 1024)
+            r.fail(at + "/swirls", "expected a whole number from 1 to 1024");
+        s.swirls = it->get<int>();
+    }
+    return s;
+}
+
+StartShape readStart(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"sphere", "vdb", "mesh"});
+    if (v.size() != 1) r.fail(at, "expected exactly one of sphere, vdb, mesh");
+    StartShape s;
+    if (auto it = v.find("sphere"); it != v.end()) {
+        r.onlyKeys(*it, at + "/sphere", {"center", "radius"});
+        s.kind = StartShape::Kind::Sphere;
+        s.center = r.vec3(r.require(*it, at + "/sphere", "center"), at + "/sphere/center");
+        s.radius = r.positive(r.require(*it, at + "/sphere", "radius"), at + "/sphere/radius");
+    } else {
+        const bool vdb = v.contains("vdb");
+        s.kind = vdb ? StartShape::Kind::Vdb : StartShape::Kind::Mesh;
+        const std::string key = vdb ? "vdb" : "mesh";
+        s.file = r.string(v[key], at + "/" + key);
+        if (s.file.empty()) r.fail(at + "/" + key, "empty file name");
+    }
+    return s;
+}
+
+std::pair<int, int> lineAndColumn(const std::string& text, std::size_t byte) {
+    int line = 1, col = 1;
+    for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+        if (text[i] == '\n') {
+            ++line;
+            col = 1;
+        } else {
+            ++col;
+        }
+    }
+    return {line, col};
+}
+
+json vecJson(const Eigen::Vector3d& v) {
+    return json::array({v.x(), v.y(), v.z()});
+}
+
+json placementJson(const Placement& p) {
+    json j;
+    j["t"] = vecJson(p.t);
+    if (p.hasRotation()) j["r"] = json::array({p.axis.x(), p.axis.y(), p.axis.z(), p.angleDegrees});
+    if (p.scale != Eigen::Vector3d::Ones()) {
+        if (p.uniformScale())
+            j["s"] = p.scale.x();
+        else
+            j["s"] = vecJson(p.scale);
+    }
+    return j;
+}
+
+const char* mirrorName(MirrorAxis m) {
+    switch (m) {
+    case MirrorAxis::X:
+        return "x";
+    case MirrorAxis::Y:
+        return "y";
+    case MirrorAxis::Z:
+        return "z";
+    case MirrorAxis::None:
+        break;
+    }
+    return "";
+}
+
+} // namespace
+
+StrokeScript parseStrokeScript(const std::string& text, const std::string& name) {
+    const Reader r(name);
+    json root;
+    try {
+        root = json::parse(text);
+    } catch (const json::parse_error& e) {
+        const auto [line, col] = lineAndColumn(text, e.byte == 0 ? 0 : e.byte - 1);
+        std::string why = e.what();
+        if (auto p = why.find("syntax error"); p != std::string::npos) why = why.substr(p);
+        throw ScriptError(name + ": line " + std::to_string(line) + ", column " +
+                          std::to_string(col) + ": invalid JSON (" + why + ")");
+    } catch (const json::out_of_range& e) {
+        // A number too large for a double (1e999): the parser names the token, not its
+        // position, so find the token to report where it stands.
+        const std::string why = e.what();
+        const auto q0 = why.find('\''), q1 = why.rfind('\'');
+        const std::string token = q0 < q1 ? why.substr(q0 + 1, q1 - q0 - 1) : "";
+        const auto [line, col] = lineAndColumn(text, token.empty() ? 0 : text.find(token));
+        throw ScriptError(name + ": line " + std::to_string(line) + ", column " +
+                          std::to_string(col) + ": the number " + token + " is not finite");
+    }
+    r.onlyKeys(root, "", {"sweepers", "grid", "start", "strokes"});
+    StrokeScript s;
+    const json& version = r.require(root, "", "sweepers");
+    if (!version.is_number_integer() || version.get<long long>() != 1)
+        r.fail("/sweepers", "unsupported format version " + Reader::describe(version) +
+                                " (this build reads version 1)");
+    if (auto it = root.find("grid"); it != root.end()) {
+        r.onlyKeys(*it, "/grid", {"voxel_size", "half_width"});
+        if (it->contains("voxel_size"))
+            s.grid.voxelSize = r.positive((*it)["voxel_size"], "/grid/voxel_size");
+        if (it->contains("half_width")) {
+            s.grid.halfWidth = r.number((*it)["half_width"], "/grid/half_width");
+            if (s.grid.halfWidth < 1.0 || s.grid.halfWidth > 64.0)
+                r.fail("/grid/half_width", "must lie between 1 and 64 voxels");
+        }
+    }
+    if (auto it = root.find("start"); it != root.end()) s.start = readStart(r, *it, "/start");
+    const json& strokes = r.require(root, "", "strokes");
+    if (!strokes.is_array()) r.fail("/strokes", "expected an array of strokes");
+    for (std::size_t i = 0; i < strokes.size(); ++i) {
+        const std::string at = "/strokes/" + std::to_string(i);
+        const json& v = strokes[i];
+        if (!v.is_object()) r.fail(at, "expected an object");
+        const std::string type = r.string(r.require(v, at, "type"), at + "/type");
+        if (type == "sweep")
+            s.strokes.emplace_back(readSweep(r, v, at));
+        else if (type == "swirl")
+            s.strokes.emplace_back(readSwirl(r, v, at));
+        else
+            r.fail(at + "/type", "unknown stroke type \"" + type + "\" (expected sweep or swirl)");
+    }
+    return s;
+}
+
+StrokeScript readStrokeScript(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw ScriptError(path + ": cannot open the file");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    if (in.bad()) throw ScriptError(path + ": cannot read the file");
+    return parseStrokeScript(ss.str(), path);
+}
+
+std::string formatStrokeScript(const StrokeScript& s) {
+    json root;
+    root["sweepers"] = s.version;
+    root["grid"] = {{"voxel_size", s.grid.voxelSize}, {"half_width", s.grid.halfWidth}};
+    switch (s.start.kind) {
+    case StartShape::Kind::Sphere:
+        root["start"] = {
+            {"sphere", {{"center", vecJson(s.start.center)}, {"radius", s.start.radius}}}};
+        break;
+    case StartShape::Kind::Vdb:
+        root["start"] = {{"vdb", s.start.file}};
+        break;
+    case StartShape::Kind::Mesh:
+        root["start"] = {{"mesh", s.start.file}};
+        break;
+    }
+    json strokes = json::array();
+    for (const Stroke& stroke : s.strokes) {
+        json j;
+        if (const auto* sw = std::get_if<SweepStroke>(&stroke)) {
+            j["type"] = "sweep";
+            if (sw->mirror != MirrorAxis::None) j["mirror"] = mirrorName(sw->mirror);
+            json tools = json::array();
+            for (const ToolSpec& t : sw->tools) {
+                json tj;
+                tj["shape"] = t.shape;
+                if (t.shape == "ball")
+                    tj["size"] = t.size.x();
+                else
+                    tj["size"] = vecJson(t.size);
+                tj["falloff"] = t.falloff;
+                json path = json::array();
+                for (const Placement& p : t.path)
+                    path.push_back(placementJson(p));
+                tj["path"] = path;
+                tools.push_back(tj);
+            }
+            j["tools"] = tools;
+        } else {
+            const auto& sr = std::get<SwirlStroke>(stroke);
+            j["type"] = "swirl";
+            j["at"] = vecJson(sr.at);
+            j["move"] = vecJson(sr.move);
+            j["radius"] = sr.radius;
+            j["ring"] = sr.ring;
+            j["swirls"] = sr.swirls;
+        }
+        strokes.push_back(j);
+    }
+    root["strokes"] = strokes;
+    return root.dump(2) + "\n";
+}
+
+void writeStrokeScript(const StrokeScript& script, const std::string& path) {
+    writeTextAtomically(path, formatStrokeScript(script));
+}
+
+Sweep toSweep(const SweepStroke& stroke) {
+    Sweep sweep;
+    sweep.mirror = stroke.mirror;
+    for (const ToolSpec& t : stroke.tools) {
+        SweptTool st;
+        st.shape = t.shape == "ball" ? std::make_shared<EllipsoidShape>(t.size.x())
+                                     : std::make_shared<EllipsoidShape>(t.size);
+        st.falloff = t.falloff;
+        st.path = t.path;
+        sweep.tools.push_back(std::move(st));
+    }
+    return sweep;
+}
+
+} // namespace sweepers

@@ -1,0 +1,20 @@
+#include "tools/tool_shape.h"
+
+#include <stdexcept>
+
+#include "core/falloff.h"
+
+namespace sweepers {
+
+PlacedTool::PlacedTool(std::unique_ptr<PlacedShape> shape, double falloff)
+    : shape_(std::move(shape)), falloff_(falloff) {
+    if (!(falloff > 0.0)) throw std::invalid_argument("a tool's falloff must be positive");
+    coating_ = shape_->bounds().expanded(falloff);
+}
+
+double PlacedTool::influence(const Eigen::Vector3d& p) const {
+    if (!coating_.contains(p)) return 0.0;
+    return falloffMu(shape_->distance(p), falloff_);
+}
+
+} // namespace sweepers

@@ -1,0 +1,56 @@
+// The interface every tool shape implements, and the tool (shape + falloff) built on it.
+//
+// A shape is defined in its own local frame; a placement (an affine world-from-local map,
+// possibly with non-uniform scale or a mirror) puts it in the world. Distances are always
+// measured in world units (3.36), so the falloff slope the artist sees does not depend on
+// how the tool was scaled. A baked tool (a level set or mesh turned into a tool, 3.4.3)
+// implements the same two classes.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "core/box.h"
+
+namespace sweepers {
+
+// A shape at one placement. Evaluated many times per placement, so implementations
+// precompute what they can when placed.
+class PlacedShape {
+  public:
+    virtual ~PlacedShape() = default;
+    // Euclidean world distance from p to the filled shape; 0 inside.
+    virtual double distance(const Eigen::Vector3d& p) const = 0;
+    // World box enclosing the shape.
+    virtual Box bounds() const = 0;
+};
+
+class ToolShape {
+  public:
+    virtual ~ToolShape() = default;
+    virtual std::string name() const = 0;
+    virtual std::unique_ptr<PlacedShape> place(const Eigen::Affine3d& worldFromLocal) const = 0;
+};
+
+// A shape placed in the world with its falloff width lambda (world units): the influence
+// phi = mu_lambda(distance) (3.3) is 1 inside the tool, in (0, 1) on its coating of
+// thickness lambda, 0 outside.
+class PlacedTool {
+  public:
+    PlacedTool(std::unique_ptr<PlacedShape> shape, double falloff);
+
+    double influence(const Eigen::Vector3d& p) const;
+    double distance(const Eigen::Vector3d& p) const { return shape_->distance(p); }
+    // Box enclosing the tool and its coating: outside it the influence is exactly 0.
+    const Box& coatingBounds() const { return coating_; }
+    double falloff() const { return falloff_; }
+
+  private:
+    std::unique_ptr<PlacedShape> shape_;
+    double falloff_;
+    Box coating_;
+};
+
+} // namespace sweepers

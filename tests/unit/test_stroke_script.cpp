@@ -1,0 +1,189 @@
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "io/stroke_script.h"
+
+using namespace sweepers;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kFull = R"({
+  "sweepers": 1,
+  "grid": { "voxel_size": 0.015625, "half_width": 3.5 },
+  "start": { "sphere": { "center": [0.1, -0.2, 0.3], "radius": 0.9 } },
+  "strokes": [
+    { "type": "sweep", "mirror": "x",
+      "tools": [ { "shape": "ball", "size": 0.3, "falloff": 0.25,
+                   "path": [ { "t": [0.2, 1, 0] },
+                             { "t": [0.2, 1.6, 0], "r": [0, 0, 1, 30], "s": 1.2 },
+                             { "t": [0.3, 1.7, 0.1], "r": [0, 0, 1, 45], "s": [1.2, 1.3, 1.1] } ] },
+                 { "shape": "ellipsoid", "size": [0.1, 0.2, 0.3], "falloff": 0.125,
+                   "path": [ { "t": [0.5, 0, 0] }, { "t": [0.5, 0.1, 0] },
+                             { "t": [0.5, 0.2, 0], "r": [1, 0, 0, -20] } ] } ] },
+    { "type": "swirl", "at": [0, 0, 1], "move": [0, 0, 0.5], "radius": 0.3,
+      "ring": "convolution", "swirls": 12 }
+  ]
+})";
+
+std::string errorOf(const std::string& text) {
+    try {
+        parseStrokeScript(text, "bad.json");
+    } catch (const ScriptError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+// A minimal valid script with one field replaced by `stroke`.
+std::string withStroke(const std::string& stroke) {
+    return R"({"sweepers": 1, "strokes": [)" + stroke + "]}";
+}
+
+const std::string kGoodTool =
+    R"("shape": "ball", "size": 0.3, "falloff": 0.3, "path": [{"t": [0,0,0]}, {"t": [0,0.5,0]}])";
+
+} // namespace
+
+TEST(StrokeScript, EveryFieldRoundTrips) {
+    const StrokeScript a = parseStrokeScript(kFull, "full.json");
+    EXPECT_EQ(a.grid.voxelSize, 0.015625);
+    EXPECT_EQ(a.grid.halfWidth, 3.5);
+    EXPECT_EQ(a.start.kind, StartShape::Kind::Sphere);
+    EXPECT_EQ(a.start.center, Eigen::Vector3d(0.1, -0.2, 0.3));
+    EXPECT_EQ(a.start.radius, 0.9);
+    ASSERT_EQ(a.strokes.size(), 2u);
+    const auto& sweep = std::get<SweepStroke>(a.strokes[0]);
+    EXPECT_EQ(sweep.mirror, MirrorAxis::X);
+    ASSERT_EQ(sweep.tools.size(), 2u);
+    EXPECT_EQ(sweep.tools[0].shape, "ball");
+    EXPECT_EQ(sweep.tools[0].size, Eigen::Vector3d::Constant(0.3));
+    EXPECT_EQ(sweep.tools[0].falloff, 0.25);
+    EXPECT_EQ(sweep.tools[0].path[1].angleDegrees, 30.0);
+    EXPECT_EQ(sweep.tools[0].path[1].scale, Eigen::Vector3d::Constant(1.2));
+    EXPECT_EQ(sweep.tools[0].path[2].scale, Eigen::Vector3d(1.2, 1.3, 1.1));
+    EXPECT_EQ(sweep.tools[1].shape, "ellipsoid");
+    EXPECT_EQ(sweep.tools[1].size, Eigen::Vector3d(0.1, 0.2, 0.3));
+    EXPECT_EQ(sweep.tools[1].path[2].axis, Eigen::Vector3d(1, 0, 0));
+    const auto& swirl = std::get<SwirlStroke>(a.strokes[1]);
+    EXPECT_EQ(swirl.ring, "convolution");
+    EXPECT_EQ(swirl.swirls, 12);
+    EXPECT_EQ(swirl.move, Eigen::Vector3d(0, 0, 0.5));
+
+    // Written and read back, everything is equal, and writing again is byte-identical.
+    const std::string once = formatStrokeScript(a);
+    const StrokeScript b = parseStrokeScript(once, "again.json");
+    EXPECT_EQ(formatStrokeScript(b), once);
+    const auto& sweepB = std::get<SweepStroke>(b.strokes[0]);
+    for (std::size_t t = 0; t < 2; ++t)
+        for (std::size_t i = 0; i < 3; ++i)
+            EXPECT_TRUE(sweepB.tools[t].path[i] == sweep.tools[t].path[i]);
+    EXPECT_EQ(b.start.center, a.start.center);
+}
+
+TEST(StrokeScript, FileStartsRoundTripAndAtomicWrite) {
+    const fs::path dir = fs::temp_directory_path() / "sweepers_script_test";
+    fs::create_directories(dir);
+    for (const char* start : {R"({"vdb": "shapes/bunny.vdb"})", R"({"mesh": "tool.obj"})"}) {
+        const std::string text =
+            std::string(R"({"sweepers": 1, "start": )") + start + R"(, "strokes": []})";
+        const StrokeScript s = parseStrokeScript(text, "s.json");
+        const fs::path file = dir / "out.json";
+        writeStrokeScript(s, file.string());
+        const StrokeScript back = readStrokeScript(file.string());
+        EXPECT_EQ(back.start.kind, s.start.kind);
+        EXPECT_EQ(back.start.file, s.start.file);
+    }
+    // Nothing but the target is left in the directory.
+    int files = 0;
+    for (const auto& e : fs::directory_iterator(dir))
+        files += e.is_regular_file();
+    EXPECT_EQ(files, 1);
+    // An unwritable target fails cleanly.
+    EXPECT_THROW(writeStrokeScript(StrokeScript{}, (dir / "missing" / "x.json").string()),
+                 std::runtime_error);
+    fs::remove_all(dir);
+}
+
+TEST(StrokeScript, BadInputIsRefusedWithFileLocationAndReason) {
+    struct Bad {
+        std::string text, location, reason;
+    };
+    const std::vector<Bad> bad{
+        {"{\"sweepers\": 1,\n  \"strokes\": [ }", "line 2, column 16", "invalid JSON"},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "cube", "size": 0.3, "falloff": 0.3, "path": []}]})"),
+         "/strokes/0/tools/0/shape", "unknown shape \"cube\""},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "ball", "size": -0.3, "falloff": 0.3, "path": []}]})"),
+         "/strokes/0/tools/0/size", "must be positive"},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "ball", "size": 0, "falloff": 0.3, "path": []}]})"),
+         "/strokes/0/tools/0/size", "must be positive"},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "ellipsoid", "size": [0.1, 0, 0.2], "falloff": 0.3, "path": []}]})"),
+         "/strokes/0/tools/0/size/1", "must be positive"},
+        {withStroke(R"({"type": "sweep", "tools": [{)" + kGoodTool.substr(0, 44) +
+                    R"("falloff": NaN}]})"),
+         "line 1", "invalid JSON"},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 1e999, "path": []}]})"),
+         "line 1, column 99", "the number 1e999 is not finite"},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3, "path": [{"t": [0,0,0]}]}]})"),
+         "/strokes/0/tools/0/path", "at least two placements"},
+        {withStroke(R"({"type": "smudge"})"), "/strokes/0/type", "unknown stroke type \"smudge\""},
+        {withStroke(R"({"type": "sweep", "tools": [{)" + kGoodTool + R"(, "fallof": 0.2}]})"),
+         "/strokes/0/tools/0/fallof", "unknown field"},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3, "path": [{"t": [0,0]}, {"t": [0,0,1]}]}]})"),
+         "/strokes/0/tools/0/path/0/t", "3 numbers"},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3, "path": [{"t": [0,0,0]}, {"t": [0,0,0], "r": [0,0,1,180]}]}]})"),
+         "/strokes/0/tools/0/path/1", "more than 179 degrees"},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3, "path": [{"t": [0,0,0]}, {"t": [0,0,0], "s": [1, -1, 1]}]}]})"),
+         "/strokes/0/tools/0/path/1/s/1", "must be positive"},
+        {withStroke(
+             R"({"type": "swirl", "at": [0,0,0], "move": [0,0,1], "radius": 0.2, "ring": "square"})"),
+         "/strokes/0/ring", "discrete"},
+        {R"({"sweepers": 2, "strokes": []})", "/sweepers", "unsupported format version"},
+        {R"({"sweepers": 1})", "/strokes", "missing field"},
+        {R"({"sweepers": 1, "grid": {"voxel_size": "small"}, "strokes": []})", "/grid/voxel_size",
+         "expected a number"},
+        {R"({"sweepers": 1, "start": {"sphere": {"center": [0,0,0], "radius": 1}, "vdb": "a.vdb"}, "strokes": []})",
+         "/start", "exactly one"},
+        {R"([1, 2])", "/", "expected an object"},
+    };
+    for (const Bad& b : bad) {
+        const std::string msg = errorOf(b.text);
+        EXPECT_EQ(msg.rfind("bad.json: ", 0), 0u) << msg;
+        EXPECT_NE(msg.find(b.location), std::string::npos) << msg << "\n  wanted " << b.location;
+        EXPECT_NE(msg.find(b.reason), std::string::npos) << msg << "\n  wanted " << b.reason;
+        EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
+    }
+}
+
+TEST(StrokeScript, MissingFileIsAScriptError) {
+    try {
+        readStrokeScript("/nonexistent/dir/script.json");
+        FAIL() << "no error";
+    } catch (const ScriptError& e) {
+        EXPECT_NE(std::string(e.what()).find("/nonexistent/dir/script.json: cannot open"),
+                  std::string::npos);
+    }
+}
+
+TEST(StrokeScript, ShippedScriptsAreValid) {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(SWEEPERS_DATA_DIR)) {
+        if (e.path().extension() != ".json") continue;
+        ++n;
+        EXPECT_NO_THROW(readStrokeScript(e.path().string())) << e.path();
+    }
+    EXPECT_GT(n, 0);
+}
