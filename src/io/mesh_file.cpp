@@ -1,0 +1,105 @@
+#include "io/mesh_file.h"
+
+#include <algorithm>
+#include <cctype>
+#include <fstream>
+#include <memory>
+
+#include <assimp/Exporter.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "io/atomic_file.h"
+
+namespace sweepers {
+
+namespace {
+
+std::string extension(const std::string& path) {
+    const auto dot = path.find_last_of('.');
+    if (dot == std::string::npos || path.find('/', dot) != std::string::npos) return "";
+    std::string e = path.substr(dot + 1);
+    std::transform(e.begin(), e.end(), e.begin(), [](unsigned char c) { return std::tolower(c); });
+    return e;
+}
+
+const char* exportFormat(const std::string& ext) {
+    if (ext == "obj") return "objnomtl";
+    if (ext == "ply") return "plyb";
+    if (ext == "stl") return "stlb";
+    return nullptr;
+}
+
+} // namespace
+
+bool isMeshPath(const std::string& path) {
+    return exportFormat(extension(path)) != nullptr;
+}
+
+void writeMesh(const TriangleMesh& mesh, const std::string& path) {
+    const char* format = exportFormat(extension(path));
+    if (!format) throw FileError(path + ": unknown mesh format (use .obj, .ply or .stl)");
+
+    // A one-mesh scene; the aiScene destructor frees everything it points to.
+    auto scene = std::make_unique<aiScene>();
+    scene->mRootNode = new aiNode();
+    scene->mRootNode->mMeshes = new unsigned int[1]{0};
+    scene->mRootNode->mNumMeshes = 1;
+    scene->mMaterials = new aiMaterial* [1] { new aiMaterial() };
+    scene->mNumMaterials = 1;
+    aiMesh* m = new aiMesh();
+    scene->mMeshes = new aiMesh* [1] { m };
+    scene->mNumMeshes = 1;
+    m->mMaterialIndex = 0;
+    m->mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
+    m->mNumVertices = unsigned(mesh.positions.size());
+    m->mVertices = new aiVector3D[m->mNumVertices];
+    const bool normals = mesh.normals.size() == mesh.positions.size();
+    if (normals) m->mNormals = new aiVector3D[m->mNumVertices];
+    for (unsigned i = 0; i < m->mNumVertices; ++i) {
+        const auto& p = mesh.positions[i];
+        m->mVertices[i] = aiVector3D(p.x(), p.y(), p.z());
+        if (normals)
+            m->mNormals[i] =
+                aiVector3D(mesh.normals[i].x(), mesh.normals[i].y(), mesh.normals[i].z());
+    }
+    m->mNumFaces = unsigned(mesh.triangles.size());
+    m->mFaces = new aiFace[m->mNumFaces];
+    for (unsigned f = 0; f < m->mNumFaces; ++f) {
+        m->mFaces[f].mNumIndices = 3;
+        m->mFaces[f].mIndices =
+            new unsigned int[3]{unsigned(mesh.triangles[f][0]), unsigned(mesh.triangles[f][1]),
+                                unsigned(mesh.triangles[f][2])};
+    }
+    writeFileAtomically(path, [&](const std::string& tmp) {
+        Assimp::Exporter exporter;
+        if (exporter.Export(scene.get(), format, tmp) != AI_SUCCESS)
+            throw FileError(path + ": cannot write the mesh (" + exporter.GetErrorString() + ")");
+    });
+}
+
+TriangleMesh readMesh(const std::string& path) {
+    if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(
+        path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+    if (!scene)
+        throw FileError(path + ": cannot read the mesh (" + importer.GetErrorString() + ")");
+    TriangleMesh out;
+    for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
+        const aiMesh* m = scene->mMeshes[mi];
+        const int base = int(out.positions.size());
+        for (unsigned i = 0; i < m->mNumVertices; ++i)
+            out.positions.emplace_back(m->mVertices[i].x, m->mVertices[i].y, m->mVertices[i].z);
+        for (unsigned f = 0; f < m->mNumFaces; ++f) {
+            if (m->mFaces[f].mNumIndices != 3) continue;
+            const unsigned* ix = m->mFaces[f].mIndices;
+            out.triangles.emplace_back(base + int(ix[0]), base + int(ix[1]), base + int(ix[2]));
+        }
+    }
+    if (out.triangles.empty()) throw FileError(path + ": the mesh has no triangles");
+    return out;
+}
+
+} // namespace sweepers

@@ -1,0 +1,43 @@
+// Runs a stroke script on a level set: builds the start shape, then advects the grid
+// through every segment of every stroke.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "io/stroke_script.h"
+#include "levelset/advect.h"
+
+namespace sweepers {
+
+struct RunOptions {
+    double voxelSize = 0.0; // > 0 overrides the script's grid.voxel_size
+    AdvectOptions advect;
+};
+
+struct SegmentReport {
+    std::size_t stroke = 0, segment = 0;
+    AdvectStats stats;
+    double seconds = 0.0;
+};
+
+// Progress: (segments done, segments in all).
+using Progress = std::function<void(std::size_t, std::size_t)>;
+
+// The start grid of a script (sphere, or the vdb / mesh file relative to `scriptDir`).
+GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir,
+                      const RunOptions& options);
+
+// Throws ScriptError before touching the grid when the script holds strokes this build
+// cannot apply.
+void requireApplicable(const StrokeScript& script, const std::string& name);
+
+// Applies all strokes; calls `after` (if set) after each stroke with its index.
+std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,
+                                        const RunOptions& options, const Progress& progress = {},
+                                        const std::function<void(std::size_t)>& after = {});
+
+std::string directoryOf(const std::string& path);
+
+} // namespace sweepers

@@ -1,0 +1,61 @@
+#include "io/vdb_file.h"
+
+#include <cmath>
+#include <fstream>
+
+#include <openvdb/io/File.h>
+
+#include "io/atomic_file.h"
+#include "levelset/level_set.h"
+
+namespace sweepers {
+
+GridPtr readLevelSet(const std::string& path) {
+    initVdb();
+    if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
+    openvdb::GridPtrVecPtr grids;
+    try {
+        openvdb::io::File file(path);
+        file.open();
+        grids = file.getGrids();
+        file.close();
+    } catch (const std::exception& e) {
+        throw FileError(path + ": not a readable VDB file (" + e.what() + ")");
+    }
+    std::string seen;
+    for (const openvdb::GridBase::Ptr& base : *grids) {
+        const std::string what = "'" + base->getName() + "' (" + base->valueType() + ", " +
+                                 openvdb::GridBase::gridClassToString(base->getGridClass()) + ")";
+        seen += (seen.empty() ? "" : ", ") + what;
+        if (base->getGridClass() != openvdb::GRID_LEVEL_SET) continue;
+        GridPtr grid = openvdb::gridPtrCast<Grid>(base);
+        if (!grid) continue;
+        if (!grid->hasUniformVoxels() || !grid->transform().isLinear())
+            throw FileError(path + ": grid '" + grid->getName() +
+                            "' has non-uniform voxels; Sweepers needs cubic voxels");
+        const double hw = halfWidthOf(*grid);
+        if (!(hw >= kMinHalfWidth - 1e-6))
+            throw FileError(path + ": grid '" + grid->getName() + "' has a band of " +
+                            std::to_string(hw) + " voxels; Sweepers needs at least 2");
+        markAsDocument(*grid);
+        return grid;
+    }
+    throw FileError(
+        path + ": no float level set in the file" +
+        (seen.empty() ? std::string(" (it holds no grids)") : " (it holds " + seen + ")"));
+}
+
+void writeLevelSet(const Grid& grid, const std::string& path) {
+    initVdb();
+    GridPtr copy = grid.deepCopy();
+    markAsDocument(*copy);
+    copy->insertMeta("voxel_size", openvdb::FloatMetadata(float(grid.voxelSize()[0])));
+    writeFileAtomically(path, [&](const std::string& tmp) {
+        openvdb::io::File file(tmp);
+        openvdb::GridPtrVec grids{copy};
+        file.write(grids);
+        file.close();
+    });
+}
+
+} // namespace sweepers

@@ -1,0 +1,24 @@
+// VDB files (DESIGN.md section 5): one FloatGrid named "surface", class level set, linear
+// transform with the voxel size, background = half-width x voxel size, negative inside,
+// metadata creator / voxel_size / half_width. Reading accepts any float level set (any
+// name; the first level-set grid when there are several) and says why it refuses
+// anything else.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+#include "levelset/vdb.h"
+
+namespace sweepers {
+
+class FileError : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
+GridPtr readLevelSet(const std::string& path);
+// Atomic: temporary file, flush, rename.
+void writeLevelSet(const Grid& grid, const std::string& path);
+
+} // namespace sweepers

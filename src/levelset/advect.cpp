@@ -1,0 +1,179 @@
+#include "levelset/advect.h"
+
+#include <chrono>
+#include <cmath>
+#include <mutex>
+#include <vector>
+
+#include <Eigen/SVD>
+#include <openvdb/tools/ChangeBackground.h>
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/Morphology.h>
+#include <openvdb/tools/SignedFloodFill.h>
+#include <openvdb/tree/LeafManager.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+namespace sweepers {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+bool hasCrossing(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk, float v) {
+    for (int a = 0; a < 3; ++a)
+        for (int d : {-1, 1}) {
+            openvdb::Coord n = ijk;
+            n[a] += d;
+            if ((acc.getValue(n) < 0.0f) != (v < 0.0f)) return true;
+        }
+    return false;
+}
+
+// Resamples every active voxel of `grid` inside `box` from `source` at map(x).
+template <typename Map>
+std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& box,
+                     const Map& map) {
+    openvdb::tree::LeafManager<Grid::TreeType> leaves(grid.tree());
+    std::atomic<std::size_t> count{0};
+    const auto& xform = grid.transform();
+    tbb::parallel_for(leaves.leafRange(), [&](const auto& range) {
+        Grid::ConstAccessor acc = source.getConstAccessor();
+        openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
+            acc, source.transform());
+        std::size_t n = 0;
+        for (auto leaf = range.begin(); leaf; ++leaf) {
+            if (!box.hasOverlap(leaf->getNodeBoundingBox())) continue;
+            for (auto it = leaf->beginValueOn(); it; ++it) {
+                const openvdb::Coord ijk = it.getCoord();
+                if (!box.isInside(ijk)) continue;
+                const Eigen::Vector3d x = toEigen(xform.indexToWorld(ijk));
+                const Eigen::Vector3d p = map(x);
+                it.setValue(float(sampler.wsSample(toVdb(p))));
+                ++n;
+            }
+        }
+        count += n;
+    });
+    return count;
+}
+
+} // namespace
+
+openvdb::CoordBBox indexBox(const Grid& grid, const Box& world, int pad) {
+    if (world.empty()) return {};
+    const openvdb::Vec3d lo = grid.worldToIndex(toVdb(world.min));
+    const openvdb::Vec3d hi = grid.worldToIndex(toVdb(world.max));
+    return openvdb::CoordBBox(openvdb::Coord::floor(lo).offsetBy(-pad),
+                              openvdb::Coord::ceil(hi).offsetBy(pad));
+}
+
+AdvectStats advectSegment(Grid& grid, const SweepSegment& seg, const AdvectOptions& options) {
+    AdvectStats stats;
+    stats.subSteps = seg.steps();
+    const double h = grid.voxelSize()[0];
+    const double halfWidth = halfWidthOf(grid);
+    const openvdb::CoordBBox region = indexBox(grid, seg.affectedBox(), 1);
+
+    // 1. Grow the band: forward-map the interface voxels, one sub-step at a time, and mark
+    //    every image; also measure how far apart the images of neighbouring voxels land
+    //    (the stretch), which bounds how far a pre-image can sit from the old surface.
+    auto t0 = Clock::now();
+    std::vector<openvdb::Coord> interface;
+    {
+        auto acc = grid.getConstAccessor();
+        for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
+            if (!region.hasOverlap(leaf->getNodeBoundingBox())) continue;
+            for (auto it = leaf->cbeginValueOn(); it; ++it) {
+                const openvdb::Coord ijk = it.getCoord();
+                if (region.isInside(ijk) && hasCrossing(acc, ijk, *it)) interface.push_back(ijk);
+            }
+        }
+    }
+    stats.interfaceVoxels = interface.size();
+    using Marks = std::vector<openvdb::Coord>;
+    tbb::enumerable_thread_specific<Marks> marks;
+    tbb::enumerable_thread_specific<double> stretch(1.0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
+        Marks& m = marks.local();
+        double& worst = stretch.local();
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            Eigen::Vector3d p = toEigen(grid.indexToWorld(interface[i]));
+            for (int k = 0; k < seg.steps(); ++k) {
+                p = seg.forwardStep(k, p).p;
+                m.push_back(openvdb::Coord::round(grid.worldToIndex(toVdb(p))));
+            }
+            // How far the inverse map can spread a voxel-sized neighbourhood of the new
+            // surface: the largest singular value of its Jacobian.
+            Eigen::Matrix3d J;
+            for (int a = 0; a < 3; ++a) {
+                Eigen::Vector3d e = Eigen::Vector3d::Zero();
+                e[a] = 0.5 * h;
+                J.col(a) = (seg.inverseMap(p + e) - seg.inverseMap(p - e)) / h;
+            }
+            worst = std::max(worst, Eigen::JacobiSVD<Eigen::Matrix3d>(J).singularValues()[0]);
+        }
+    });
+    openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create();
+    mask->setTransform(grid.transform().copy());
+    {
+        auto macc = mask->getAccessor();
+        for (const Marks& m : marks)
+            for (const openvdb::Coord& c : m)
+                macc.setValueOn(c);
+    }
+    const int dilation = int(std::ceil(halfWidth)) + 1;
+    openvdb::tools::dilateActiveValues(mask->tree(), dilation, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                       openvdb::tools::IGNORE_TILES);
+    double maxStretch = 1.0;
+    for (double s : stretch)
+        maxStretch = std::max(maxStretch, s);
+    // Pre-images of voxels within 2 voxels of the new surface lie within 2 * stretch voxels
+    // of the old one; make sure the old band reaches that far.
+    const double needed = std::ceil(2.0 * std::min(maxStretch, 32.0)) + 1.0;
+    stats.widenedTo = std::max(halfWidth, needed);
+    GridPtr source;
+    if (needed > halfWidth) {
+        source = grid.deepCopy();
+        openvdb::tools::changeLevelSetBackground(source->tree(), float(needed * h));
+        openvdb::tools::dilateActiveValues(source->tree(), int(std::ceil(needed - halfWidth)),
+                                           openvdb::tools::NN_FACE, openvdb::tools::IGNORE_TILES);
+        renormalize(*source, indexBox(grid, seg.affectedBox(), int(needed) + 2), FmmOrder::First);
+    }
+    grid.tree().topologyUnion(mask->tree());
+    stats.growSeconds = since(t0);
+
+    // 2. Sample: composed inverse (default) or one resample per sub-step (5.3.4).
+    t0 = Clock::now();
+    if (!options.resampleEachSubStep) {
+        if (!source) source = grid.deepCopy();
+        stats.sampledVoxels = resample(grid, *source, region,
+                                       [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); });
+    } else {
+        for (int k = 0; k < seg.steps(); ++k) {
+            GridPtr step = (k == 0 && source) ? source : grid.deepCopy();
+            stats.sampledVoxels += resample(grid, *step, region, [&](const Eigen::Vector3d& x) {
+                return seg.inverseStep(k, x);
+            });
+        }
+    }
+    // Voxels inside the region that are not in the band kept their old inactive values,
+    // whose signs may now be wrong (space pulled out of the shape is inside it now):
+    // re-derive every inactive sign from the band.
+    openvdb::tools::signedFloodFill(grid.tree());
+    stats.sampleSeconds = since(t0);
+
+    // 3. Renormalize the changed region (and the band around it).
+    t0 = Clock::now();
+    openvdb::CoordBBox touched = region;
+    touched.expand(dilation);
+    if (options.renormalize) renormalize(grid, touched, options.renormalization);
+    stats.renormalizeSeconds = since(t0);
+    stats.touched = touched;
+    return stats;
+}
+
+} // namespace sweepers

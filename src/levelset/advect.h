@@ -1,0 +1,44 @@
+// Semi-Lagrangian advection of a level set through one sweep segment (thesis 5.3.3).
+//
+// The new value at a voxel x is the old grid sampled at the segment's inverse map
+// f^-1(x), composed from all inverse sub-steps before a single trilinear sample: the
+// thesis's algorithm (5.3.4) resamples after every sub-step, which blurs the shape s
+// times; that variant is kept as an option so the difference can be measured.
+//
+// Only the affected box of the segment is touched. Before sampling, the band is grown
+// where the surface moves: the interface voxels are forward-mapped sub-step by sub-step
+// and the band is activated around every image, so the new surface always lies on active
+// voxels. Strongly compressing motions could send the pre-image of a voxel next to the new
+// surface outside the old band, where the old grid only holds +-background: the band is
+// widened first (by fast marching) to cover the stretch the segment can produce, measured
+// on the forward-mapped interface.
+#pragma once
+
+#include "deform/sweep.h"
+#include "levelset/fast_marching.h"
+#include "levelset/vdb.h"
+
+namespace sweepers {
+
+struct AdvectOptions {
+    bool resampleEachSubStep = false; // the thesis's 5.3.4 variant
+    FmmOrder renormalization = FmmOrder::Second;
+    bool renormalize = true;
+};
+
+struct AdvectStats {
+    int subSteps = 0;
+    std::size_t interfaceVoxels = 0; // forward-mapped to grow the band
+    std::size_t sampledVoxels = 0;
+    double widenedTo = 0.0; // band half-width used for sampling, in voxels
+    double growSeconds = 0.0, sampleSeconds = 0.0, renormalizeSeconds = 0.0;
+    openvdb::CoordBBox touched; // index box whose values may have changed
+};
+
+AdvectStats advectSegment(Grid& grid, const SweepSegment& segment,
+                          const AdvectOptions& options = {});
+
+// The index box of a world box, grown by `pad` voxels.
+openvdb::CoordBBox indexBox(const Grid& grid, const Box& world, int pad);
+
+} // namespace sweepers

@@ -1,0 +1,45 @@
+// Creating narrow-band level sets and checking that they stay valid ones.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/box.h"
+#include "levelset/vdb.h"
+
+namespace sweepers {
+
+// Half-widths below this leave cubes that straddle the surface without an active corner,
+// which the mesher and the renormalization rely on.
+constexpr double kMinHalfWidth = 2.0;
+
+// Sphere of the given radius, as a narrow band of `halfWidth` voxels on each side.
+GridPtr makeSphere(const Eigen::Vector3d& center, double radius, double voxelSize,
+                   double halfWidth);
+
+// Level set of a closed triangle mesh (vertices in world units).
+GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
+                         const std::vector<Eigen::Vector3i>& triangles, double voxelSize,
+                         double halfWidth);
+
+// Names the grid "surface" and stamps the metadata of the file contract.
+void markAsDocument(Grid& grid);
+
+struct BandReport {
+    std::size_t activeVoxels = 0;
+    std::size_t nearInterface = 0; // active voxels within one voxel of the zero crossing
+    std::size_t unitGradient = 0;  // ... of which |grad phi| lies in [0.9, 1.1]
+    std::size_t beyondBand = 0;    // active voxels with |phi| > half-width + 1 voxel
+    std::string vdbCheck;          // tools::checkLevelSet's complaint, empty when none
+    double unitGradientFraction() const {
+        return nearInterface ? double(unitGradient) / double(nearInterface) : 1.0;
+    }
+};
+
+// Measures how well the grid is a narrow-band signed distance field.
+BandReport checkBand(const Grid& grid);
+
+// World-space box of the active voxels.
+Box activeWorldBox(const Grid& grid);
+
+} // namespace sweepers

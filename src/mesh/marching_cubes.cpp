@@ -1,0 +1,147 @@
+#include "mesh/marching_cubes.h"
+
+#include <unordered_map>
+
+#include <tbb/parallel_for.h>
+
+#include "mesh/mc_table.h"
+
+namespace sweepers {
+
+namespace {
+
+// Edge name: lowest voxel (20 bits per coordinate, +-2^19 voxels) and axis.
+std::uint64_t makeKey(const openvdb::Coord& c, int axis) {
+    const std::int64_t off = 1 << 19;
+    return (std::uint64_t(c.x() + off) << 40) | (std::uint64_t(c.y() + off) << 20) |
+           std::uint64_t(c.z() + off) | (std::uint64_t(axis) << 60);
+}
+
+MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
+    MeshChunk chunk;
+    const Grid::TreeType::LeafNodeType* leaf = grid.tree().probeConstLeaf(origin);
+    if (!leaf) return chunk;
+    Grid::ConstAccessor acc = grid.getConstAccessor();
+    const auto& xform = grid.transform();
+    const double h = grid.voxelSize()[0];
+    std::unordered_map<std::uint64_t, int> vertexOf;
+    auto gradient = [&](const openvdb::Coord& c) {
+        Eigen::Vector3f g;
+        for (int a = 0; a < 3; ++a) {
+            openvdb::Coord lo = c, hi = c;
+            lo[a] -= 1;
+            hi[a] += 1;
+            g[a] = float((acc.getValue(hi) - acc.getValue(lo)) / (2 * h));
+        }
+        return g;
+    };
+    for (auto it = leaf->cbeginValueOn(); it; ++it) {
+        const openvdb::Coord base = it.getCoord();
+        float v[8];
+        int mask = 0;
+        for (int c = 0; c < 8; ++c) {
+            v[c] = acc.getValue(base.offsetBy(c & 1, c >> 1 & 1, c >> 2 & 1));
+            if (v[c] < 0.0f) mask |= 1 << c;
+        }
+        if (mask == 0 || mask == 255) continue;
+        int ids[12];
+        for (const auto& tri : mc::triangles(mask)) {
+            for (int k = 0; k < 3; ++k) {
+                const int e = tri[k];
+                const mc::Edge& edge = mc::kEdges[e];
+                const openvdb::Coord c0 =
+                    base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
+                const std::uint64_t key = makeKey(c0, edge.axis);
+                auto [pos, inserted] = vertexOf.emplace(key, int(chunk.positions.size()));
+                if (inserted) {
+                    const float a = v[edge.c0], b = v[edge.c1];
+                    const float t = a / (a - b);
+                    openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
+                    p[edge.axis] += t;
+                    const openvdb::Vec3d w = xform.indexToWorld(p);
+                    chunk.positions.emplace_back(float(w.x()), float(w.y()), float(w.z()));
+                    openvdb::Coord c1 = c0;
+                    c1[edge.axis] += 1;
+                    Eigen::Vector3f n = (1 - t) * gradient(c0) + t * gradient(c1);
+                    const float len = n.norm();
+                    chunk.normals.push_back(len > 0 ? Eigen::Vector3f(n / len)
+                                                    : Eigen::Vector3f(0, 0, 1));
+                    chunk.edgeKeys.push_back(key);
+                }
+                ids[k] = pos->second;
+            }
+            chunk.triangles.emplace_back(ids[0], ids[1], ids[2]);
+        }
+    }
+    return chunk;
+}
+
+} // namespace
+
+void SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins) {
+    std::vector<MeshChunk> out(origins.size());
+    tbb::parallel_for(std::size_t(0), origins.size(),
+                      [&](std::size_t i) { out[i] = meshLeaf(grid, origins[i]); });
+    for (std::size_t i = 0; i < origins.size(); ++i) {
+        if (out[i].triangles.empty()) continue;
+        chunks_[origins[i]] = std::move(out[i]);
+    }
+}
+
+void SurfaceMesher::rebuild(const Grid& grid) {
+    chunks_.clear();
+    std::vector<openvdb::Coord> origins;
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
+        origins.push_back(leaf->origin());
+    meshLeaves(grid, origins);
+}
+
+std::size_t SurfaceMesher::update(const Grid& grid, const openvdb::CoordBBox& touched) {
+    openvdb::CoordBBox box = touched;
+    box.expand(1);
+    // Forget every chunk whose leaf overlaps the box, then mesh the leaves there now.
+    for (auto it = chunks_.begin(); it != chunks_.end();) {
+        const openvdb::CoordBBox leafBox =
+            openvdb::CoordBBox::createCube(it->first, Grid::TreeType::LeafNodeType::DIM);
+        it = box.hasOverlap(leafBox) ? chunks_.erase(it) : std::next(it);
+    }
+    std::vector<openvdb::Coord> origins;
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
+        if (box.hasOverlap(leaf->getNodeBoundingBox())) origins.push_back(leaf->origin());
+    meshLeaves(grid, origins);
+    return origins.size();
+}
+
+std::size_t SurfaceMesher::triangleCount() const {
+    std::size_t n = 0;
+    for (const auto& [o, c] : chunks_)
+        n += c.triangles.size();
+    return n;
+}
+
+TriangleMesh SurfaceMesher::weld() const {
+    TriangleMesh mesh;
+    std::unordered_map<std::uint64_t, int> index;
+    for (const auto& [origin, chunk] : chunks_) {
+        std::vector<int> local(chunk.positions.size());
+        for (std::size_t i = 0; i < chunk.positions.size(); ++i) {
+            auto [it, inserted] = index.emplace(chunk.edgeKeys[i], int(mesh.positions.size()));
+            if (inserted) {
+                mesh.positions.push_back(chunk.positions[i]);
+                mesh.normals.push_back(chunk.normals[i]);
+            }
+            local[i] = it->second;
+        }
+        for (const Eigen::Vector3i& t : chunk.triangles)
+            mesh.triangles.emplace_back(local[t[0]], local[t[1]], local[t[2]]);
+    }
+    return mesh;
+}
+
+TriangleMesh meshLevelSet(const Grid& grid) {
+    SurfaceMesher m;
+    m.rebuild(grid);
+    return m.weld();
+}
+
+} // namespace sweepers

@@ -1,0 +1,46 @@
+// Marching cubes over a narrow-band level set, kept in chunks of one VDB leaf each, so a
+// stroke re-meshes only the leaves it touched (plus one ring of neighbours).
+//
+// A cube belongs to the leaf holding its lowest corner and is meshed when that corner is
+// active (a valid band of half-width >= 2 has every surface-crossing cube so). Vertices
+// sit on cube edges at the linear zero crossing and are named by their edge (lowest voxel
+// and axis), which welds chunks into one watertight mesh. Normals are the SDF gradient:
+// central differences at the edge's two voxels, interpolated along the edge (5.17).
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+#include "levelset/vdb.h"
+#include "mesh/triangle_mesh.h"
+
+namespace sweepers {
+
+struct MeshChunk {
+    std::vector<Eigen::Vector3f> positions, normals;
+    std::vector<std::uint64_t> edgeKeys; // one per vertex
+    std::vector<Eigen::Vector3i> triangles;
+};
+
+class SurfaceMesher {
+  public:
+    // Meshes every active leaf.
+    void rebuild(const Grid& grid);
+    // Re-meshes the leaves overlapping `touched` grown by one voxel; returns how many.
+    std::size_t update(const Grid& grid, const openvdb::CoordBBox& touched);
+
+    const std::map<openvdb::Coord, MeshChunk>& chunks() const { return chunks_; }
+    std::size_t triangleCount() const;
+    // One mesh with the chunks welded along their shared edges.
+    TriangleMesh weld() const;
+
+  private:
+    void meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins);
+    std::map<openvdb::Coord, MeshChunk> chunks_;
+};
+
+// Convenience: the welded mesh of a whole grid.
+TriangleMesh meshLevelSet(const Grid& grid);
+
+} // namespace sweepers

@@ -1,0 +1,34 @@
+// An indexed triangle mesh and the checks an exported surface must pass.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace sweepers {
+
+struct TriangleMesh {
+    std::vector<Eigen::Vector3f> positions;
+    std::vector<Eigen::Vector3f> normals; // per vertex, may be empty
+    std::vector<Eigen::Vector3i> triangles;
+};
+
+struct MeshTopology {
+    std::size_t vertices = 0, edges = 0, faces = 0;
+    std::size_t boundaryEdges = 0;    // edges in one triangle only
+    std::size_t nonManifoldEdges = 0; // edges in more than two triangles
+    std::size_t misorientedEdges = 0; // edges whose two triangles run the same way
+    bool watertight() const { return boundaryEdges == 0 && nonManifoldEdges == 0; }
+    bool consistentlyOriented() const { return misorientedEdges == 0; }
+    long eulerCharacteristic() const { return long(vertices) - long(edges) + long(faces); }
+};
+
+MeshTopology meshTopology(const TriangleMesh& mesh);
+
+// Signed enclosed volume (divergence theorem); positive for outward-facing triangles.
+double enclosedVolume(const TriangleMesh& mesh);
+double surfaceArea(const TriangleMesh& mesh);
+
+} // namespace sweepers
