@@ -82,8 +82,11 @@ void writeMesh(const TriangleMesh& mesh, const std::string& path) {
 TriangleMesh readMesh(const std::string& path) {
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
     Assimp::Importer importer;
-    const aiScene* scene = importer.ReadFile(
-        path, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+    // Normals are dropped before joining, so that formats with per-face normals (STL) weld
+    // by position and come back watertight.
+    const aiScene* scene =
+        importer.ReadFile(path, aiProcess_Triangulate | aiProcess_DropNormals |
+                                    aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
     if (!scene)
         throw FileError(path + ": cannot read the mesh (" + importer.GetErrorString() + ")");
     TriangleMesh out;

@@ -14,6 +14,7 @@ namespace sweepers {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr double kUnitSlack = 0.05;
 
 enum State : std::uint8_t { Far = 0, Trial = 1, Known = 2, Fixed = 3 };
 
@@ -116,15 +117,37 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
         u[i] = std::abs(b.phi_[i]);
     }
 
-    // 1. Seeds: phi / |grad phi| with central differences, which turns a sampled field that
-    //    is no longer a distance back into one to second order where the field is smooth.
-    //    Where the gradient is unreliable (thin features: both neighbours across the
-    //    surface) the distance to the axis crossings is used instead. Either way the sign
-    //    is kept.
+    // 1. Seeds (voxels with a face neighbour across the surface): phi / |grad phi| with
+    //    central differences, which turns a sampled field that is no longer a distance back
+    //    into one to second order where the field is smooth, capped by the distance to the
+    //    nearest axis crossing (the surface is no farther). The sign is always kept.
+    // Thin voxels: the surface on both sides along some axis.
+    // Their central differences span the feature, and so do those of voxels up to two
+    // steps away, so those are flagged too.
+    std::vector<std::uint8_t> thin(n, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+        const bool neg = negative(b.phi_[i]);
+        for (int a = 0; a < 3 && !thin[i]; ++a) {
+            const std::size_t lo = b.neighbour(i, a, -1), hi = b.neighbour(i, a, 1);
+            thin[i] = lo != Block::npos && hi != Block::npos && negative(b.phi_[lo]) != neg &&
+                      negative(b.phi_[hi]) != neg;
+        }
+    }
+    for (std::uint8_t ring = 1; ring <= 2; ++ring) {
+        for (std::size_t i = 0; i < n; ++i) {
+            if (thin[i] != ring) continue;
+            for (int a = 0; a < 3; ++a)
+                for (int dir : {-1, 1}) {
+                    const std::size_t j = b.neighbour(i, a, dir);
+                    if (j != Block::npos && !thin[j]) thin[j] = ring + 1;
+                }
+        }
+    }
     for (std::size_t i = 0; i < n; ++i) {
         if (state[i] == Fixed) continue;
         const float p = b.phi_[i];
         double inv2 = 0.0, grad2 = 0.0;
+        float nearestCrossing = kInf;
         bool crossing = false, central = true;
         for (int a = 0; a < 3; ++a) {
             float best = kInf;
@@ -142,20 +165,34 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
                 const float t = p / (p - q); // fraction of the edge to the crossing
                 best = std::min(best, std::max(t, 1e-6f));
             }
-            if (best < kInf) inv2 += 1.0 / (double(best) * best);
+            if (best < kInf) {
+                inv2 += 1.0 / (double(best) * best);
+                nearestCrossing = std::min(nearestCrossing, best);
+            }
             if (negative(side[0]) != negative(p) && negative(side[1]) != negative(p))
                 central = false;
             const double g = 0.5 * (double(side[1]) - side[0]);
             grad2 += g * g;
         }
         if (!crossing) continue;
-        const float byCrossings = float(h / std::sqrt(inv2));
-        float d = byCrossings;
-        if (central && grad2 > 1e-12 * double(h) * h) {
-            const float byGradient = float(std::abs(p) * h / std::sqrt(grad2));
-            // Both estimate the same distance; the gradient one is the accurate one, but it
-            // may never exceed a voxel (the voxel touches a crossing).
-            d = std::min(byGradient, h);
+        // The surface is no farther than the nearest axis crossing; the plane through the
+        // crossings is a first-order estimate below that.
+        const bool nearThin = thin[i] != 0;
+        float d;
+        if (!central || nearThin) {
+            // On or next to a feature about one voxel thin (the surface on both sides along an
+            // axis) no gradient estimate is trustworthy, so the value is kept: recomputing it
+            // would move its crossings a little every time and let the feature drift.
+            d = std::min(std::abs(p), h);
+        } else if (grad2 > 1e-12 * double(h) * h) {
+            const double gradNorm = std::sqrt(grad2) / h;
+            // A value whose gradient is already unit within kUnitSlack is a distance: kept, so
+            // that renormalizing a renormalized grid changes nothing and nothing drifts.
+            d = std::abs(gradNorm - 1.0) < kUnitSlack
+                    ? std::abs(p)
+                    : std::min(float(std::abs(p) / gradNorm), nearestCrossing * h);
+        } else {
+            d = float(h / std::sqrt(inv2)); // distance to the plane through the crossings
         }
         u[i] = d;
         state[i] = Known;

@@ -17,12 +17,22 @@ void initVdb() {
     std::call_once(once, [] { openvdb::initialize(); });
 }
 
+openvdb::math::Transform::Ptr documentTransform(double voxelSize) {
+    auto xform = openvdb::math::Transform::createLinearTransform(voxelSize);
+    xform->postTranslate(openvdb::Vec3d(0.5 * voxelSize));
+    return xform;
+}
+
 GridPtr makeSphere(const Eigen::Vector3d& center, double radius, double voxelSize,
                    double halfWidth) {
     initVdb();
+    // OpenVDB builds it on the plain lattice; shifting the centre by half a voxel there and
+    // then the lattice by half a voxel puts it back where it belongs.
+    const Eigen::Vector3d c = center - Eigen::Vector3d::Constant(0.5 * voxelSize);
     GridPtr g = openvdb::tools::createLevelSetSphere<Grid>(
-        float(radius), openvdb::Vec3f(float(center.x()), float(center.y()), float(center.z())),
-        float(voxelSize), float(halfWidth));
+        float(radius), openvdb::Vec3f(float(c.x()), float(c.y()), float(c.z())), float(voxelSize),
+        float(halfWidth));
+    g->setTransform(documentTransform(voxelSize));
     markAsDocument(*g);
     return g;
 }
@@ -31,13 +41,11 @@ GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
                          const std::vector<Eigen::Vector3i>& triangles, double voxelSize,
                          double halfWidth) {
     initVdb();
-    const auto xform = openvdb::math::Transform::createLinearTransform(voxelSize);
-    std::vector<openvdb::Vec3s> points;
+    const auto xform = documentTransform(voxelSize);
+    std::vector<openvdb::Vec3s> points; // world space
     points.reserve(vertices.size());
-    for (const auto& v : vertices) {
-        const openvdb::Vec3d p = xform->worldToIndex(openvdb::Vec3d(v.x(), v.y(), v.z()));
-        points.emplace_back(float(p.x()), float(p.y()), float(p.z()));
-    }
+    for (const auto& v : vertices)
+        points.emplace_back(v.x(), v.y(), v.z());
     std::vector<openvdb::Vec3I> tris;
     tris.reserve(triangles.size());
     for (const auto& t : triangles)

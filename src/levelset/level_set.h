@@ -13,6 +13,12 @@ namespace sweepers {
 // which the mesher and the renormalization rely on.
 constexpr double kMinHalfWidth = 2.0;
 
+// The transform of every grid the engine creates: voxel size h, voxel centres at
+// (i + 1/2) h. No voxel centre lies on a coordinate plane, so a sheet squeezed onto a
+// mirror plane thinner than a voxel leaves the grid instead of surviving as a one-voxel
+// membrane, and a symmetric shape is sampled symmetrically.
+openvdb::math::Transform::Ptr documentTransform(double voxelSize);
+
 // Sphere of the given radius, as a narrow band of `halfWidth` voxels on each side.
 GridPtr makeSphere(const Eigen::Vector3d& center, double radius, double voxelSize,
                    double halfWidth);

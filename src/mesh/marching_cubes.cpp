@@ -44,31 +44,55 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
             if (v[c] < 0.0f) mask |= 1 << c;
         }
         if (mask == 0 || mask == 255) continue;
-        int ids[12];
-        for (const auto& tri : mc::triangles(mask)) {
+        // The vertex on cube edge e, created on first use.
+        auto vertexOn = [&](int e) {
+            const mc::Edge& edge = mc::kEdges[e];
+            const openvdb::Coord c0 =
+                base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
+            const std::uint64_t key = makeKey(c0, edge.axis);
+            auto [pos, inserted] = vertexOf.emplace(key, int(chunk.positions.size()));
+            if (inserted) {
+                const float a = v[edge.c0], b = v[edge.c1];
+                const float t = a / (a - b);
+                openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
+                p[edge.axis] += t;
+                const openvdb::Vec3d w = xform.indexToWorld(p);
+                chunk.positions.emplace_back(float(w.x()), float(w.y()), float(w.z()));
+                openvdb::Coord c1 = c0;
+                c1[edge.axis] += 1;
+                const Eigen::Vector3f n = (1 - t) * gradient(c0) + t * gradient(c1);
+                const float len = n.norm();
+                chunk.normals.push_back(len > 0 ? Eigen::Vector3f(n / len)
+                                                : Eigen::Vector3f(0, 0, 1));
+                chunk.edgeKeys.push_back(key);
+            }
+            return pos->second;
+        };
+        const mc::Case& cube = mc::lookup(mask);
+        int ids[3];
+        for (const auto& tri : cube.triangles) {
             for (int k = 0; k < 3; ++k) {
                 const int e = tri[k];
-                const mc::Edge& edge = mc::kEdges[e];
-                const openvdb::Coord c0 =
-                    base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
-                const std::uint64_t key = makeKey(c0, edge.axis);
-                auto [pos, inserted] = vertexOf.emplace(key, int(chunk.positions.size()));
-                if (inserted) {
-                    const float a = v[edge.c0], b = v[edge.c1];
-                    const float t = a / (a - b);
-                    openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
-                    p[edge.axis] += t;
-                    const openvdb::Vec3d w = xform.indexToWorld(p);
-                    chunk.positions.emplace_back(float(w.x()), float(w.y()), float(w.z()));
-                    openvdb::Coord c1 = c0;
-                    c1[edge.axis] += 1;
-                    Eigen::Vector3f n = (1 - t) * gradient(c0) + t * gradient(c1);
-                    const float len = n.norm();
-                    chunk.normals.push_back(len > 0 ? Eigen::Vector3f(n / len)
-                                                    : Eigen::Vector3f(0, 0, 1));
-                    chunk.edgeKeys.push_back(key);
+                if (e >= mc::kCentre) {
+                    // A cycle's centre: never shared with another cube.
+                    const int cycle = e - mc::kCentre;
+                    const std::uint64_t key = makeKey(base, 3) | (std::uint64_t(cycle) << 62);
+                    auto [pos, inserted] = vertexOf.emplace(key, int(chunk.positions.size()));
+                    if (inserted) {
+                        Eigen::Vector3f p = Eigen::Vector3f::Zero(), nrm = Eigen::Vector3f::Zero();
+                        for (std::uint8_t ce : cube.cycles[cycle]) {
+                            const int vi = vertexOn(ce);
+                            p += chunk.positions[vi];
+                            nrm += chunk.normals[vi];
+                        }
+                        chunk.positions.push_back(p / float(cube.cycles[cycle].size()));
+                        chunk.normals.push_back(nrm.normalized());
+                        chunk.edgeKeys.push_back(key);
+                    }
+                    ids[k] = pos->second;
+                } else {
+                    ids[k] = vertexOn(e);
                 }
-                ids[k] = pos->second;
             }
             chunk.triangles.emplace_back(ids[0], ids[1], ids[2]);
         }

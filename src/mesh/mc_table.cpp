@@ -28,11 +28,23 @@ int edgeIndex(int a, int b) {
     throw std::logic_error("not an edge");
 }
 
+// Two cube edges lie on a common face when some axis bit is fixed on all four corners.
+bool shareFace(int a, int b) {
+    for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side) {
+            bool all = true;
+            for (int c : {kEdges[a].c0, kEdges[a].c1, kEdges[b].c0, kEdges[b].c1})
+                all = all && ((c >> axis & 1) == side);
+            if (all) return true;
+        }
+    return false;
+}
+
 Eigen::Vector3d edgeMid(int e) {
     return 0.5 * (cornerPos(kEdges[e].c0) + cornerPos(kEdges[e].c1));
 }
 
-std::vector<std::array<std::uint8_t, 3>> build(int mask) {
+Case build(int mask) {
     auto inside = [&](int c) { return (mask >> c & 1) != 0; };
     std::array<int, 12> next;
     next.fill(-1);
@@ -76,27 +88,42 @@ std::vector<std::array<std::uint8_t, 3>> build(int mask) {
             }
         }
     }
-    std::vector<std::array<std::uint8_t, 3>> tris;
+    Case out;
     std::array<bool, 12> used{};
     for (int start = 0; start < 12; ++start) {
         if (next[start] == -1 || used[start]) continue;
-        std::vector<int> cycle;
+        std::vector<std::uint8_t> cycle;
         for (int e = start; !used[e]; e = next[e]) {
             if (next[e] == -1) throw std::logic_error("open cycle");
             used[e] = true;
-            cycle.push_back(e);
+            cycle.push_back(std::uint8_t(e));
         }
+        const std::size_t n = cycle.size();
         // The segments run with the inside on their left seen from outside the cube, so the
-        // cycle turns clockwise seen from outside the surface: fan it in reverse.
-        for (std::size_t i = 1; i + 1 < cycle.size(); ++i)
-            tris.push_back(
-                {std::uint8_t(cycle[0]), std::uint8_t(cycle[i + 1]), std::uint8_t(cycle[i])});
+        // cycle turns clockwise seen from outside the surface: triangles go the other way.
+        int apex = -1;
+        for (std::size_t k = 0; k < n && apex < 0; ++k) {
+            bool clean = true;
+            for (std::size_t j = 2; j + 1 < n; ++j)
+                clean = clean && !shareFace(cycle[k], cycle[(k + j) % n]);
+            if (clean) apex = int(k);
+        }
+        if (apex >= 0) {
+            for (std::size_t j = 1; j + 1 < n; ++j)
+                out.triangles.push_back(
+                    {cycle[apex], cycle[(apex + j + 1) % n], cycle[(apex + j) % n]});
+        } else {
+            const std::uint8_t centre = std::uint8_t(kCentre + out.cycles.size());
+            for (std::size_t j = 0; j < n; ++j)
+                out.triangles.push_back({centre, cycle[(j + 1) % n], cycle[j]});
+        }
+        out.cycles.push_back(cycle);
     }
-    return tris;
+    return out;
 }
 
-std::array<std::vector<std::array<std::uint8_t, 3>>, 256> buildAll() {
-    std::array<std::vector<std::array<std::uint8_t, 3>>, 256> t;
+std::array<Case, 256> buildAll() {
+    std::array<Case, 256> t;
     for (int m = 0; m < 256; ++m)
         t[m] = build(m);
     return t;
@@ -106,7 +133,7 @@ std::array<std::vector<std::array<std::uint8_t, 3>>, 256> buildAll() {
 
 const std::array<Edge, 12> kEdges = makeEdges();
 
-const std::vector<std::array<std::uint8_t, 3>>& triangles(int mask) {
+const Case& lookup(int mask) {
     static const auto table = buildAll();
     return table[mask & 255];
 }

@@ -23,7 +23,22 @@ struct Edge {
 };
 extern const std::array<Edge, 12> kEdges;
 
-// For configuration `mask` (bit c set: corner c inside), triangles as triples of edges.
-const std::vector<std::array<std::uint8_t, 3>>& triangles(int mask);
+// A vertex index below 12 names the crossing on that cube edge; kCentre + k names the
+// centre of cycle k (the mean of its edge vertices). A cycle is fanned from one of its own
+// vertices when no fan diagonal joins two vertices on a common cube face; otherwise from
+// its centre, since such a diagonal would be shared with the neighbouring cube's fan and
+// make the mesh non-manifold there.
+constexpr std::uint8_t kCentre = 12;
+
+struct Case {
+    std::vector<std::array<std::uint8_t, 3>> triangles;
+    std::vector<std::vector<std::uint8_t>> cycles; // edge indices, in order
+};
+
+// For configuration `mask` (bit c set: corner c inside).
+const Case& lookup(int mask);
+inline const std::vector<std::array<std::uint8_t, 3>>& triangles(int mask) {
+    return lookup(mask).triangles;
+}
 
 } // namespace sweepers::mc

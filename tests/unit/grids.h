@@ -1,0 +1,33 @@
+// Analytic level sets for the engine tests, built voxel by voxel from exact distances.
+#pragma once
+
+#include <functional>
+
+#include <openvdb/tools/SignedFloodFill.h>
+
+#include "levelset/level_set.h"
+
+namespace sweepers::test {
+
+// Narrow band of the given signed distance function over the index box.
+inline GridPtr gridFromSdf(const std::function<double(const Eigen::Vector3d&)>& sdf,
+                           double voxelSize, double halfWidth, const openvdb::CoordBBox& box) {
+    initVdb();
+    GridPtr g = Grid::create(float(voxelSize * halfWidth));
+    g->setTransform(documentTransform(voxelSize));
+    auto acc = g->getAccessor();
+    for (auto it = box.begin(); it; ++it) {
+        const double d = sdf(toEigen(g->indexToWorld(*it)));
+        if (std::abs(d) < voxelSize * halfWidth) acc.setValueOn(*it, float(d));
+    }
+    openvdb::tools::signedFloodFill(g->tree());
+    markAsDocument(*g);
+    return g;
+}
+
+inline double torusSdf(const Eigen::Vector3d& p, double R, double r) {
+    const double q = std::hypot(p.x(), p.y()) - R;
+    return std::hypot(q, p.z()) - r;
+}
+
+} // namespace sweepers::test

@@ -1,0 +1,140 @@
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "io/script_runner.h"
+#include "levelset/advect.h"
+#include "levelset/level_set.h"
+#include "levelset/measure.h"
+#include "mesh/marching_cubes.h"
+#include "tools/ellipsoid.h"
+
+using namespace sweepers;
+namespace fs = std::filesystem;
+
+namespace {
+
+Eigen::Vector3d centroid(const TriangleMesh& m) {
+    Eigen::Vector3d c = Eigen::Vector3d::Zero();
+    double v = 0.0;
+    for (const Eigen::Vector3i& t : m.triangles) {
+        const Eigen::Vector3d a = m.positions[t[0]].cast<double>(),
+                              b = m.positions[t[1]].cast<double>(),
+                              d = m.positions[t[2]].cast<double>();
+        const double w = a.dot(b.cross(d)) / 6.0;
+        v += w;
+        c += w * (a + b + d) / 4.0;
+    }
+    return c / v;
+}
+
+// RMS (in voxels) of phi minus the exact distance, over voxels next to the zero crossing.
+double interfaceRms(const Grid& g, const std::function<double(const Eigen::Vector3d&)>& sdf) {
+    const double h = g.voxelSize()[0];
+    auto acc = g.getConstAccessor();
+    double sum2 = 0.0;
+    std::size_t n = 0;
+    for (auto it = g.cbeginValueOn(); it; ++it) {
+        bool near = false;
+        for (int a = 0; a < 3; ++a)
+            for (int d : {-1, 1}) {
+                openvdb::Coord c = it.getCoord();
+                c[a] += d;
+                near = near || ((acc.getValue(c) < 0) != (*it < 0));
+            }
+        if (!near) continue;
+        const double e = (*it - sdf(toEigen(g.indexToWorld(it.getCoord())))) / h;
+        sum2 += e * e;
+        ++n;
+    }
+    return std::sqrt(sum2 / n);
+}
+
+Placement at(const Eigen::Vector3d& t) {
+    Placement p;
+    p.t = t;
+    return p;
+}
+
+struct Translated {
+    GridPtr grid;
+    Eigen::Vector3d d;
+    double h;
+};
+
+// A ball tool enclosing the whole unit sphere (and its band) moves it by 20 voxels.
+Translated translateSphere(bool perSubStep) {
+    const double h = 1.0 / 32;
+    const Eigen::Vector3d d = 20 * h * Eigen::Vector3d(0.6, 0.8, 0.0);
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+    Sweep sweep{{{std::make_shared<EllipsoidShape>(1.25), 0.4, {at({0, 0, 0}), at(d)}}}};
+    const SweepSegment seg(sweep, 0);
+    AdvectOptions o;
+    o.resampleEachSubStep = perSubStep;
+    advectSegment(*g, seg, o);
+    return {g, d, h};
+}
+
+} // namespace
+
+TEST(Advect, EnclosedSphereTranslatesExactly) {
+    const Translated t = translateSphere(false);
+    const Grid& g = *t.grid;
+    const TriangleMesh mesh = meshLevelSet(g);
+    const Eigen::Vector3d c = centroid(mesh);
+    const double volume = measureLevelSet(g).volume, exactVolume = 4.0 / 3.0 * M_PI;
+    const double rms =
+        interfaceRms(g, [&](const Eigen::Vector3d& p) { return (p - t.d).norm() - 1.0; });
+    std::printf("[ advect ] centre off by %.4f voxels, volume %+.3f%%, interface RMS %.4f voxels\n",
+                (c - t.d).norm() / t.h, 100 * (volume - exactVolume) / exactVolume, rms);
+    EXPECT_LT((c - t.d).norm(), 0.1 * t.h);
+    EXPECT_NEAR(volume, exactVolume, 0.005 * exactVolume);
+    EXPECT_LT(rms, 0.1);
+}
+
+TEST(Advect, ComposedInverseBeatsResamplingEachSubStep) {
+    const Translated composed = translateSphere(false), perStep = translateSphere(true);
+    auto sdf = [&](const Eigen::Vector3d& p) { return (p - composed.d).norm() - 1.0; };
+    const double a = interfaceRms(*composed.grid, sdf), b = interfaceRms(*perStep.grid, sdf);
+    std::printf(
+        "[ advect ] interface RMS: composed inverse %.4f voxels, per sub-step %.4f voxels\n", a, b);
+    EXPECT_LT(a, b);
+}
+
+TEST(Advect, DataScriptsKeepAValidNarrowBand) {
+    for (const auto& entry : fs::directory_iterator(SWEEPERS_DATA_DIR)) {
+        if (entry.path().extension() != ".json") continue;
+        const std::string name = entry.path().filename().string();
+        const StrokeScript script = readStrokeScript(entry.path().string());
+        RunOptions options;
+        GridPtr g = makeStartGrid(script, entry.path().parent_path().string(), options);
+        applyStrokes(*g, script, options, {}, [&](std::size_t stroke) {
+            const BandReport r = checkBand(*g);
+            EXPECT_EQ(r.vdbCheck, "") << name << " stroke " << stroke;
+            EXPECT_GE(r.unitGradientFraction(), 0.95) << name << " stroke " << stroke;
+            EXPECT_EQ(r.beyondBand, 0u) << name << " stroke " << stroke;
+            std::printf("[ band ] %s stroke %zu: %zu active, |grad| in [0.9, 1.1] on %.2f%% of %zu "
+                        "interface voxels\n",
+                        name.c_str(), stroke, r.activeVoxels, 100 * r.unitGradientFraction(),
+                        r.nearInterface);
+        });
+    }
+}
+
+TEST(Advect, PinchOpensAHole) {
+    const std::string path = std::string(SWEEPERS_DATA_DIR) + "/pinch.json";
+    const StrokeScript script = readStrokeScript(path);
+    RunOptions options;
+    GridPtr g = makeStartGrid(script, SWEEPERS_DATA_DIR, options);
+    EXPECT_EQ(topologicalEulerCharacteristic(*g), 2);
+    EXPECT_EQ(meshTopology(meshLevelSet(*g)).eulerCharacteristic(), 2);
+    applyStrokes(*g, script, options);
+    const TriangleMesh mesh = meshLevelSet(*g);
+    const MeshTopology t = meshTopology(mesh);
+    EXPECT_EQ(topologicalEulerCharacteristic(*g), 0);
+    EXPECT_EQ(t.eulerCharacteristic(), 0);
+    EXPECT_TRUE(t.watertight());
+    EXPECT_TRUE(t.consistentlyOriented());
+}

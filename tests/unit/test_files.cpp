@@ -1,0 +1,145 @@
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <openvdb/io/File.h>
+#include <openvdb/tools/LevelSetMeasure.h>
+#include <openvdb/tools/LevelSetSphere.h>
+
+#include "io/mesh_file.h"
+#include "io/vdb_file.h"
+#include "levelset/level_set.h"
+#include "mesh/marching_cubes.h"
+
+using namespace sweepers;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TempDir {
+    fs::path path;
+    TempDir() : path(fs::temp_directory_path() / ("sweepers_files_" + std::to_string(::getpid()))) {
+        fs::create_directories(path);
+    }
+    ~TempDir() { fs::remove_all(path); }
+    std::string operator/(const std::string& f) const { return (path / f).string(); }
+    std::size_t count() const {
+        return std::size_t(std::distance(fs::directory_iterator(path), fs::directory_iterator()));
+    }
+};
+
+std::string errorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const std::exception& e) {
+        return e.what();
+    }
+    return "";
+}
+
+void writeGrids(const std::string& path, openvdb::GridPtrVec grids) {
+    openvdb::io::File file(path);
+    file.write(grids);
+    file.close();
+}
+
+} // namespace
+
+TEST(VdbFile, RoundTripIsBitExact) {
+    TempDir dir;
+    GridPtr g = makeSphere({0.1, 0.2, 0.3}, 0.5, 1.0 / 50, 3);
+    writeLevelSet(*g, dir / "s.vdb");
+    EXPECT_EQ(dir.count(), 1u); // no temporary left behind
+    GridPtr back = readLevelSet(dir / "s.vdb");
+    EXPECT_EQ(back->getName(), "surface");
+    EXPECT_EQ(back->getGridClass(), openvdb::GRID_LEVEL_SET);
+    // OpenVDB recomputes the map's derived terms on reading: equal to a few ulps.
+    EXPECT_DOUBLE_EQ(back->voxelSize()[0], g->voxelSize()[0]);
+    EXPECT_EQ(back->background(), g->background());
+    EXPECT_EQ(back->activeVoxelCount(), g->activeVoxelCount());
+    EXPECT_TRUE(back->tree().hasSameTopology(g->tree()));
+    std::size_t differ = 0;
+    auto acc = g->getConstAccessor();
+    for (auto it = back->cbeginValueAll(); it; ++it)
+        differ += acc.getValue(it.getCoord()) != *it;
+    EXPECT_EQ(differ, 0u);
+    EXPECT_EQ(back->metaValue<std::string>("creator"), "sweepers");
+    EXPECT_FLOAT_EQ(back->metaValue<float>("half_width"), 3.0f);
+}
+
+TEST(VdbFile, ReadsTheFirstLevelSetAndRefusesOtherGrids) {
+    TempDir dir;
+    initVdb();
+    openvdb::FloatGrid::Ptr fog = openvdb::FloatGrid::create(0.0f);
+    fog->setName("density");
+    fog->setGridClass(openvdb::GRID_FOG_VOLUME);
+    fog->tree().setValue(openvdb::Coord(1, 2, 3), 0.5f);
+    openvdb::Vec3fGrid::Ptr vel = openvdb::Vec3fGrid::create();
+    vel->setName("vel");
+    openvdb::FloatGrid::Ptr ls =
+        openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, {0, 0, 0}, 0.1f, 3.0f);
+    ls->setName("my_shape");
+
+    writeGrids(dir / "mixed.vdb", {fog, vel, ls});
+    GridPtr g = readLevelSet(dir / "mixed.vdb");
+    EXPECT_EQ(g->activeVoxelCount(), ls->activeVoxelCount());
+
+    writeGrids(dir / "fog.vdb", {fog});
+    EXPECT_NE(errorOf([&] {
+                  readLevelSet(dir / "fog.vdb");
+              }).find("no float level set in the file (it holds 'density' (float, fog volume))"),
+              std::string::npos);
+    writeGrids(dir / "vec.vdb", {vel});
+    EXPECT_NE(errorOf([&] { readLevelSet(dir / "vec.vdb"); }).find("'vel' (vec3s"),
+              std::string::npos);
+
+    std::ofstream(dir / "junk.vdb") << "this is not a vdb file";
+    EXPECT_NE(errorOf([&] { readLevelSet(dir / "junk.vdb"); }).find("not a readable VDB file"),
+              std::string::npos);
+    EXPECT_NE(errorOf([&] { readLevelSet(dir / "none.vdb"); }).find("cannot open"),
+              std::string::npos);
+
+    openvdb::FloatGrid::Ptr thin =
+        openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(1.0f, {0, 0, 0}, 0.1f, 1.5f);
+    writeGrids(dir / "thin.vdb", {thin});
+    EXPECT_NE(errorOf([&] { readLevelSet(dir / "thin.vdb"); }).find("needs at least 2"),
+              std::string::npos);
+}
+
+TEST(VdbFile, UnwritableTargetFailsCleanly) {
+    TempDir dir;
+    GridPtr g = makeSphere({0, 0, 0}, 0.5, 0.05, 3);
+    EXPECT_THROW(writeLevelSet(*g, dir / "no/such/dir/x.vdb"), std::runtime_error);
+    EXPECT_EQ(dir.count(), 0u);
+}
+
+TEST(MeshFile, ExportsReadBackWatertight) {
+    TempDir dir;
+    GridPtr g = makeSphere({0, 0, 0}, 0.6, 1.0 / 30, 3);
+    const TriangleMesh mesh = meshLevelSet(*g);
+    for (const char* name : {"s.obj", "s.ply", "s.stl"}) {
+        writeMesh(mesh, dir / name);
+        const TriangleMesh back = readMesh(dir / name);
+        EXPECT_EQ(back.triangles.size(), mesh.triangles.size()) << name;
+        const MeshTopology t = meshTopology(back);
+        EXPECT_TRUE(t.watertight()) << name;
+        EXPECT_TRUE(t.consistentlyOriented()) << name;
+        EXPECT_EQ(t.eulerCharacteristic(), 2) << name;
+        EXPECT_NEAR(enclosedVolume(back), enclosedVolume(mesh), 1e-4 * enclosedVolume(mesh))
+            << name;
+    }
+    EXPECT_EQ(dir.count(), 3u);
+    EXPECT_THROW(writeMesh(mesh, dir / "s.xyz"), FileError);
+}
+
+TEST(MeshFile, MeshStartBecomesALevelSet) {
+    TempDir dir;
+    GridPtr g = makeSphere({0, 0, 0}, 0.6, 1.0 / 30, 3);
+    writeMesh(meshLevelSet(*g), dir / "s.obj");
+    const TriangleMesh m = readMesh(dir / "s.obj");
+    GridPtr back = levelSetFromMesh(m.positions, m.triangles, 1.0 / 30, 3);
+    EXPECT_EQ(back->getGridClass(), openvdb::GRID_LEVEL_SET);
+    EXPECT_EQ(checkBand(*back).vdbCheck, "");
+    EXPECT_NEAR(openvdb::tools::levelSetVolume(*back), openvdb::tools::levelSetVolume(*g),
+                0.01 * openvdb::tools::levelSetVolume(*g));
+}

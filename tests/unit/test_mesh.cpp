@@ -1,0 +1,112 @@
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+#include <openvdb/tools/LevelSetMeasure.h>
+
+#include "grids.h"
+#include "levelset/advect.h"
+#include "levelset/measure.h"
+#include "mesh/marching_cubes.h"
+#include "mesh/mc_table.h"
+#include "tools/ellipsoid.h"
+
+using namespace sweepers;
+
+TEST(MarchingCubes, TableClosesEveryConfiguration) {
+    // In every configuration the triangles use a vertex on each crossing edge and on no
+    // other edge, and each cycle centre they use belongs to a cycle of the case.
+    for (int mask = 0; mask < 256; ++mask) {
+        std::array<int, 12> uses{};
+        for (const auto& tri : mc::triangles(mask))
+            for (int e : tri) {
+                if (e >= mc::kCentre) {
+                    EXPECT_LT(e - mc::kCentre, int(mc::lookup(mask).cycles.size()));
+                    continue;
+                }
+                ++uses[e];
+            }
+        for (int e = 0; e < 12; ++e) {
+            const bool crossing =
+                ((mask >> mc::kEdges[e].c0) & 1) != ((mask >> mc::kEdges[e].c1) & 1);
+            EXPECT_EQ(uses[e] > 0, crossing) << "mask " << mask << " edge " << e;
+        }
+    }
+    EXPECT_TRUE(mc::triangles(0).empty());
+    EXPECT_TRUE(mc::triangles(255).empty());
+    EXPECT_EQ(mc::triangles(1).size(), 1u);
+}
+
+TEST(MarchingCubes, RandomFieldsGiveWatertightOrientedMeshes) {
+    // Noise fields exercise every ambiguous configuration; the mesh must still close.
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    for (int trial = 0; trial < 5; ++trial) {
+        GridPtr g = Grid::create(3.0f);
+        g->setTransform(documentTransform(0.1));
+        auto acc = g->getAccessor();
+        for (int x = 0; x < 12; ++x)
+            for (int y = 0; y < 12; ++y)
+                for (int z = 0; z < 12; ++z) {
+                    // Positive on the border so the surface is closed.
+                    const bool border = x == 0 || y == 0 || z == 0 || x == 11 || y == 11 || z == 11;
+                    acc.setValueOn(openvdb::Coord(x, y, z), border ? 1.0f : u(rng));
+                }
+        const MeshTopology t = meshTopology(meshLevelSet(*g));
+        EXPECT_GT(t.faces, 100u);
+        EXPECT_TRUE(t.watertight()) << trial;
+        EXPECT_TRUE(t.consistentlyOriented()) << trial;
+    }
+}
+
+TEST(MarchingCubes, SphereAndTorusMeshes) {
+    const double h = 1.0 / 40;
+    struct Shape {
+        GridPtr grid;
+        long chi;
+    };
+    const std::vector<Shape> shapes{
+        {makeSphere({0.1, 0, 0}, 0.7, h, 3), 2},
+        {test::gridFromSdf([](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); }, h,
+                           3, openvdb::CoordBBox::createCube({-40, -40, -15}, 80)),
+         0}};
+    for (const Shape& s : shapes) {
+        const TriangleMesh m = meshLevelSet(*s.grid);
+        const MeshTopology t = meshTopology(m);
+        EXPECT_TRUE(t.watertight());
+        EXPECT_TRUE(t.consistentlyOriented());
+        EXPECT_EQ(t.eulerCharacteristic(), s.chi);
+        EXPECT_EQ(topologicalEulerCharacteristic(*s.grid), s.chi);
+        const double grid = openvdb::tools::levelSetVolume(*s.grid);
+        EXPECT_NEAR(enclosedVolume(m), grid, 0.01 * grid); // positive: normals face out
+        // Vertex normals (SDF gradient) agree with the triangles' orientation.
+        std::size_t agree = 0;
+        for (const Eigen::Vector3i& tri : m.triangles) {
+            const Eigen::Vector3f n = (m.positions[tri[1]] - m.positions[tri[0]])
+                                          .cross(m.positions[tri[2]] - m.positions[tri[0]]);
+            agree += n.dot(m.normals[tri[0]] + m.normals[tri[1]] + m.normals[tri[2]]) > 0;
+        }
+        EXPECT_GT(double(agree) / m.triangles.size(), 0.999);
+    }
+}
+
+TEST(MarchingCubes, IncrementalUpdateMatchesRebuild) {
+    const double h = 1.0 / 32;
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+    SurfaceMesher incremental;
+    incremental.rebuild(*g);
+    Placement a, b;
+    a.t = {0, 0.9, 0};
+    b.t = {0.1, 1.3, 0};
+    const Sweep sweep{{{std::make_shared<EllipsoidShape>(0.3), 0.3, {a, b}}}};
+    const AdvectStats stats = advectSegment(*g, SweepSegment(sweep, 0));
+    const std::size_t remeshed = incremental.update(*g, stats.touched);
+    SurfaceMesher full;
+    full.rebuild(*g);
+    EXPECT_LT(remeshed, g->tree().leafCount() / 2); // only the stroke's neighbourhood
+    const TriangleMesh x = incremental.weld(), y = full.weld();
+    ASSERT_EQ(x.triangles.size(), y.triangles.size());
+    ASSERT_EQ(x.positions.size(), y.positions.size());
+    EXPECT_NEAR(enclosedVolume(x), enclosedVolume(y), 1e-9);
+    EXPECT_TRUE(meshTopology(x).watertight());
+}
