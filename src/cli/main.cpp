@@ -85,6 +85,7 @@ json infoJson(const LevelSetMeasures& m) {
             {"volume", m.volume},
             {"area", m.area},
             {"euler_characteristic", m.eulerCharacteristic},
+            {"euler_characteristic_curvature", m.curvatureEuler},
             {"genus", m.genus},
             {"components", m.components}};
 }
@@ -98,11 +99,12 @@ int runInfo(const std::string& path, bool asJson) {
     }
     std::printf("%s\n  voxel size %g, half-width %g voxels\n  %zu active voxels in %zu leaves, "
                 "%.1f MiB\n  bbox [%g %g %g] - [%g %g %g]\n  volume %.6g, area %.6g\n"
-                "  Euler characteristic %d, genus %d, %zu connected component(s)\n",
+                "  Euler characteristic %d (LevelSetMeasure's curvature integral: %d), genus %d, "
+                "%zu connected component(s)\n",
                 path.c_str(), m.voxelSize, m.halfWidth, m.activeVoxels, m.leafNodes,
                 m.memoryBytes / 1048576.0, m.bounds.min.x(), m.bounds.min.y(), m.bounds.min.z(),
                 m.bounds.max.x(), m.bounds.max.y(), m.bounds.max.z(), m.volume, m.area,
-                m.eulerCharacteristic, m.genus, m.components);
+                m.eulerCharacteristic, m.curvatureEuler, m.genus, m.components);
     return 0;
 }
 

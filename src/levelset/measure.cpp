@@ -21,12 +21,12 @@ LevelSetMeasures measureLevelSet(const Grid& grid) {
     openvdb::tools::LevelSetMeasure<Grid> measure(grid);
     m.volume = measure.volume(true);
     m.area = measure.area(true);
-    m.eulerCharacteristic = measure.eulerCharacteristic();
-    m.genus = measure.genus();
-    m.topologicalEuler = topologicalEulerCharacteristic(grid);
+    m.curvatureEuler = measure.eulerCharacteristic();
+    m.eulerCharacteristic = topologicalEulerCharacteristic(grid);
     std::vector<GridPtr> parts;
     openvdb::tools::segmentSDF(grid, parts);
     m.components = parts.size();
+    m.genus = int(m.components) - m.eulerCharacteristic / 2;
     return m;
 }
 

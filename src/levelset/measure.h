@@ -11,8 +11,9 @@ struct LevelSetMeasures {
     std::size_t activeVoxels = 0, leafNodes = 0, memoryBytes = 0;
     Box bounds; // world box of the active voxels
     double volume = 0.0, area = 0.0;
-    int eulerCharacteristic = 0, genus = 0; // OpenVDB's curvature integral
-    int topologicalEuler = 0;               // exact count on the voxels, see below
+    int eulerCharacteristic = 0; // exact count on the voxels, see below
+    int curvatureEuler = 0;      // OpenVDB's LevelSetMeasure (Gaussian curvature integral)
+    int genus = 0;               // total: components - chi / 2
     std::size_t components = 0;
 };
 

@@ -1,0 +1,99 @@
+#!/usr/bin/env bash
+# sweepers-cli end to end: real scripts in, VDB and meshes out, read back by independent
+# readers (vdb_print from libopenvdb-tools, pyopenvdb under Debian's python3); every
+# failure path exits non-zero with one line on stderr and leaves no output file.
+set -euo pipefail
+cli=$1
+data=$2
+py=/usr/bin/python3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+
+# --- new, read by vdb_print and pyopenvdb ------------------------------------------
+"$cli" new -o "$tmp/sphere.vdb" --radius 0.5 --voxel-size 0.025
+vdb_print -l "$tmp/sphere.vdb" >"$tmp/print" || fail "vdb_print could not read the file"
+grep -q "surface" "$tmp/print" || fail "vdb_print: no grid named surface"
+grep -q "level set" "$tmp/print" || fail "vdb_print: not a level set"
+"$py" - "$tmp/sphere.vdb" <<'PY'
+import sys, pyopenvdb as vdb
+grids, meta = vdb.readAll(sys.argv[1])
+assert len(grids) == 1, grids
+g = grids[0]
+assert g.name == "surface", g.name
+assert g.gridClass == vdb.GridClass.LEVEL_SET, g.gridClass
+assert abs(g.transform.voxelSize()[0] - 0.025) < 1e-12, g.transform.voxelSize()
+assert abs(g.background - 3 * 0.025) < 1e-7, g.background
+assert g["creator"] == "sweepers", g.metadata
+PY
+
+# --- apply a real script, export a mesh, check the numbers --------------------------
+"$cli" apply "$data/horn.json" -o "$tmp/horn.vdb" --voxel-size 0.03125 --mesh "$tmp/horn.stl" 2>"$tmp/log"
+grep -q "volume" "$tmp/log" || fail "apply printed no volume"
+grep -q "segment 4 / 4" "$tmp/log" || fail "apply showed no progress"
+[ -s "$tmp/horn.stl" ] || fail "no mesh written"
+"$cli" info --json "$tmp/horn.vdb" >"$tmp/info.json"
+"$py" - "$tmp/info.json" <<'PY'
+import json, sys
+info = json.load(open(sys.argv[1]))
+assert info["voxel_size"] == 0.03125, info
+assert info["euler_characteristic"] == 2 and info["genus"] == 0, info
+assert info["components"] == 1, info
+assert 4.19 < info["volume"] < 6.0, info  # the unit sphere grew a horn
+PY
+"$cli" mesh "$tmp/horn.vdb" -o "$tmp/horn.obj" 2>/dev/null
+grep -q "^f " "$tmp/horn.obj" || fail "mesh wrote no faces"
+
+# --- the same script gives identical grids on 1 and 2 threads ------------------------
+"$cli" --threads 1 apply "$data/twisted_limb.json" -o "$tmp/t1.vdb" --voxel-size 0.03125 -q
+"$cli" --threads 2 apply "$data/twisted_limb.json" -o "$tmp/t2.vdb" --voxel-size 0.03125 -q
+# (The files differ in their random UUIDs; compare the grids.)
+"$py" - "$tmp/t1.vdb" "$tmp/t2.vdb" <<'PY' || fail "--threads 1 and 2 gave different grids"
+import sys, pyopenvdb as vdb
+def voxels(path):
+    g = vdb.read(path, "surface")
+    return g.activeVoxelCount(), sorted((i["min"], i["value"]) for i in g.citerOnValues())
+a, b = voxels(sys.argv[1]), voxels(sys.argv[2])
+assert a[0] > 1000 and a == b, (a[0], b[0])
+PY
+
+# --- failure paths --------------------------------------------------------------------
+expect_failure() { # name, expected message part, output file that must not exist, command...
+  local name=$1 message=$2 output=$3
+  shift 3
+  if "$@" >"$tmp/out" 2>"$tmp/err"; then fail "$name: succeeded"; fi
+  [ "$(wc -l <"$tmp/err")" -eq 1 ] || { cat "$tmp/err"; fail "$name: not one line on stderr"; }
+  grep -q -- "$message" "$tmp/err" || { cat "$tmp/err"; fail "$name: message lacks '$message'"; }
+  [ ! -e "$output" ] || fail "$name: left $output behind"
+  ls "$tmp" | grep -q "tmp-" && fail "$name: left a temporary file"
+  return 0
+}
+"$py" - "$tmp" <<'PY'
+import sys, pyopenvdb as vdb
+d = sys.argv[1]
+fog = vdb.FloatGrid(0.0); fog.name = "density"; fog.gridClass = vdb.GridClass.FOG_VOLUME
+fog.fill((0, 0, 0), (3, 3, 3), 1.0)
+vdb.write(d + "/fog.vdb", grids=[fog])
+vec = vdb.Vec3SGrid(); vec.name = "velocity"
+vec.fill((0, 0, 0), (3, 3, 3), (1, 0, 0))
+vdb.write(d + "/vec.vdb", grids=[vec])
+PY
+printf '{"sweepers": 1, "start": {"vdb": "fog.vdb"}, "strokes": []}' >"$tmp/fogstart.json"
+printf '{"sweepers": 1, "strokes": [{"type": "sweep", "tools": []}]}' >"$tmp/bad.json"
+printf 'not json' >"$tmp/junk.vdb"
+mkdir "$tmp/locked" && chmod 500 "$tmp/locked"
+
+expect_failure "missing script" "missing.json: cannot open" "$tmp/o1.vdb" "$cli" apply "$tmp/missing.json" -o "$tmp/o1.vdb"
+expect_failure "bad script" "bad.json: /strokes/0/tools: expected a non-empty array" "$tmp/o2.vdb" "$cli" apply "$tmp/bad.json" -o "$tmp/o2.vdb"
+expect_failure "fog start" "no float level set in the file (it holds 'density' (float, fog volume))" "$tmp/o3.vdb" "$cli" apply "$tmp/fogstart.json" -o "$tmp/o3.vdb"
+expect_failure "fog info" "no float level set" "/nonexistent" "$cli" info "$tmp/fog.vdb"
+expect_failure "vector mesh" "'velocity' (vec3s" "$tmp/o4.obj" "$cli" mesh "$tmp/vec.vdb" -o "$tmp/o4.obj"
+expect_failure "corrupt file" "not a readable VDB file" "$tmp/o5.obj" "$cli" mesh "$tmp/junk.vdb" -o "$tmp/o5.obj"
+expect_failure "unwritable dir" "cannot write there" "$tmp/nodir/o6.vdb" "$cli" apply "$data/horn.json" -o "$tmp/nodir/o6.vdb"
+if [ "$(id -u)" -ne 0 ]; then
+  expect_failure "read-only dir" "cannot write there" "$tmp/locked/o7.vdb" "$cli" apply "$data/horn.json" -o "$tmp/locked/o7.vdb"
+fi
+expect_failure "bad mesh format" "unknown mesh format" "$tmp/o8.vdb" "$cli" apply "$data/horn.json" -o "$tmp/o8.vdb" --mesh "$tmp/o8.xyz"
+expect_failure "bad voxel size" "voxel-size" "$tmp/o9.vdb" "$cli" apply "$data/horn.json" -o "$tmp/o9.vdb" --voxel-size -1
+expect_failure "impossible size" "voxels" "$tmp/o10.vdb" "$cli" apply "$data/horn.json" -o "$tmp/o10.vdb" --voxel-size 1e-9
+echo "engine cli: ok"
