@@ -5,6 +5,7 @@
 #include "io/mesh_file.h"
 #include "io/vdb_file.h"
 #include "levelset/level_set.h"
+#include "mesh/marching_cubes.h"
 
 namespace sweepers {
 
@@ -64,6 +65,8 @@ std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,
     }
     std::vector<SegmentReport> reports;
     std::size_t done = 0;
+    SurfaceMesher mesher;
+    if (options.remesh) mesher.rebuild(grid);
     for (std::size_t i = 0; i < sweeps.size(); ++i) {
         for (std::size_t k = 0; k < sweeps[i].segmentCount(); ++k) {
             const auto t0 = std::chrono::steady_clock::now();
@@ -72,8 +75,13 @@ std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,
             r.stroke = i;
             r.segment = k;
             r.stats = advectSegment(grid, seg, options.advect);
-            r.seconds =
-                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            const auto t1 = std::chrono::steady_clock::now();
+            r.seconds = std::chrono::duration<double>(t1 - t0).count();
+            if (options.remesh) {
+                r.remeshedLeaves = mesher.update(grid, r.stats.touched);
+                r.meshSeconds =
+                    std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+            }
             reports.push_back(r);
             if (progress) progress(++done, total);
         }

@@ -14,12 +14,15 @@ namespace sweepers {
 struct RunOptions {
     double voxelSize = 0.0; // > 0 overrides the script's grid.voxel_size
     AdvectOptions advect;
+    bool remesh = false; // keep a mesh up to date after every segment, as the modeler does
 };
 
 struct SegmentReport {
     std::size_t stroke = 0, segment = 0;
     AdvectStats stats;
-    double seconds = 0.0;
+    double seconds = 0.0;     // advection, renormalization included
+    double meshSeconds = 0.0; // incremental re-meshing of the touched leaves (when asked)
+    std::size_t remeshedLeaves = 0;
 };
 
 // Progress: (segments done, segments in all).

@@ -19,6 +19,10 @@ namespace sweepers {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// The stretch of the inverse map varies smoothly along the surface: measuring it at one
+// interface voxel in four finds its maximum to within the margin the widening adds.
+constexpr std::size_t kStretchSampling = 4;
 double since(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
@@ -104,8 +108,11 @@ AdvectStats advectSegment(Grid& grid, const SweepSegment& seg, const AdvectOptio
             Eigen::Vector3d p = toEigen(grid.indexToWorld(interface[i]));
             for (int k = 0; k < seg.steps(); ++k) {
                 p = seg.forwardStep(k, p).p;
-                m.push_back(openvdb::Coord::round(grid.worldToIndex(toVdb(p))));
+                // Intermediate surfaces only need a band when they are stored.
+                if (options.resampleEachSubStep || k + 1 == seg.steps())
+                    m.push_back(openvdb::Coord::round(grid.worldToIndex(toVdb(p))));
             }
+            if (i % kStretchSampling != 0) continue;
             // How far the inverse map can spread a voxel-sized neighbourhood of the new
             // surface: the largest singular value of its Jacobian.
             Eigen::Matrix3d J;
@@ -131,17 +138,29 @@ AdvectStats advectSegment(Grid& grid, const SweepSegment& seg, const AdvectOptio
     double maxStretch = 1.0;
     for (double s : stretch)
         maxStretch = std::max(maxStretch, s);
-    // Pre-images of voxels within 2 voxels of the new surface lie within 2 * stretch voxels
-    // of the old one; make sure the old band reaches that far.
-    const double needed = std::ceil(2.0 * std::min(maxStretch, 32.0)) + 1.0;
+    // The voxels the renormalization seeds from lie within 1.5 voxels of the new surface
+    // (crossing ends and their central differences); their pre-images lie within
+    // 1.5 * stretch voxels of the old one, and trilinear sampling reads one voxel beyond.
+    // Make sure the old band reaches that far, so none of them reads a clamped value.
+    const double needed = std::ceil(1.5 * std::min(maxStretch, 32.0) + 1.0);
     stats.widenedTo = std::max(halfWidth, needed);
     GridPtr source;
     if (needed > halfWidth) {
+        // Only the affected box is sampled, so the band is widened there alone: its active
+        // voxels are dilated in a mask and merged into a copy of the grid, whose inactive
+        // values (now +-needed voxels) carry the signs; fast marching fills in distances.
+        const openvdb::CoordBBox box = indexBox(grid, seg.affectedBox(), int(needed) + 3);
         source = grid.deepCopy();
         openvdb::tools::changeLevelSetBackground(source->tree(), float(needed * h));
-        openvdb::tools::dilateActiveValues(source->tree(), int(std::ceil(needed - halfWidth)),
+        openvdb::MaskGrid::Ptr widen = openvdb::MaskGrid::create();
+        for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
+            if (!box.hasOverlap(leaf->getNodeBoundingBox())) continue;
+            widen->tree().touchLeaf(leaf->origin())->topologyUnion(*leaf);
+        }
+        openvdb::tools::dilateActiveValues(widen->tree(), int(std::ceil(needed - halfWidth)),
                                            openvdb::tools::NN_FACE, openvdb::tools::IGNORE_TILES);
-        renormalize(*source, indexBox(grid, seg.affectedBox(), int(needed) + 2), FmmOrder::First);
+        source->tree().topologyUnion(widen->tree());
+        renormalize(*source, indexBox(grid, seg.affectedBox(), int(needed) + 1), FmmOrder::First);
     }
     grid.tree().topologyUnion(mask->tree());
     stats.growSeconds = since(t0);

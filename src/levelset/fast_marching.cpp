@@ -5,9 +5,12 @@
 #include <cstdint>
 #include <limits>
 #include <queue>
+#include <unordered_map>
 #include <vector>
 
 #include <openvdb/tools/Prune.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace sweepers {
 
@@ -18,51 +21,71 @@ constexpr double kUnitSlack = 0.05;
 
 enum State : std::uint8_t { Far = 0, Trial = 1, Known = 2, Fixed = 3 };
 
-// Dense copy of a box of the grid with a margin of fixed boundary voxels around it.
-class Block {
-  public:
-    Block(const Grid& grid, const openvdb::CoordBBox& inner, int margin)
-        : inner_(inner), outer_(inner.min().offsetBy(-margin), inner.max().offsetBy(margin)) {
-        const openvdb::Coord d = outer_.dim();
-        nx_ = d.x();
-        ny_ = d.y();
-        nz_ = d.z();
-        const std::size_t n = std::size_t(nx_) * ny_ * nz_;
-        phi_.resize(n);
-        active_.resize(n);
-        auto acc = grid.getConstAccessor();
-        std::size_t i = 0;
-        for (int x = outer_.min().x(); x <= outer_.max().x(); ++x)
-            for (int y = outer_.min().y(); y <= outer_.max().y(); ++y)
-                for (int z = outer_.min().z(); z <= outer_.max().z(); ++z, ++i) {
-                    const openvdb::Coord ijk(x, y, z);
-                    phi_[i] = acc.getValue(ijk);
-                    active_[i] = acc.isValueOn(ijk);
-                }
-    }
+using Leaf = Grid::TreeType::LeafNodeType;
+constexpr int kLeafVoxels = Leaf::SIZE; // 512, offset = x * 64 + y * 8 + z
 
-    std::size_t size() const { return phi_.size(); }
-    std::size_t index(int x, int y, int z) const { return (std::size_t(x) * ny_ + y) * nz_ + z; }
-    openvdb::Coord coord(std::size_t i) const {
-        const int z = int(i % nz_), y = int((i / nz_) % ny_), x = int(i / (std::size_t(nz_) * ny_));
-        return outer_.min().offsetBy(x, y, z);
-    }
-    bool inInner(std::size_t i) const { return inner_.isInside(coord(i)); }
-    // Neighbour along axis a in direction dir (+1/-1), or npos outside the block.
-    std::size_t neighbour(std::size_t i, int a, int dir) const {
-        const openvdb::Coord c = coord(i) - outer_.min();
-        const int dims[3] = {nx_, ny_, nz_};
-        const int v = c[a] + dir;
-        if (v < 0 || v >= dims[a]) return npos;
-        const std::size_t strides[3] = {std::size_t(ny_) * nz_, std::size_t(nz_), 1};
-        return dir > 0 ? i + strides[a] : i - strides[a];
-    }
+// The voxels of every leaf overlapping the region (grown by a margin), stored leaf by
+// leaf with each leaf's six face neighbours, so a neighbour is an add or one table
+// lookup. The band lives in leaves; voxels outside them (tiles) are far from the
+// surface and are not needed.
+class Domain {
+  public:
     static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
 
-    std::vector<float> phi_;
-    std::vector<std::uint8_t> active_;
-    openvdb::CoordBBox inner_, outer_;
-    int nx_, ny_, nz_;
+    Domain(Grid& grid, const openvdb::CoordBBox& region, int margin) : region_(region) {
+        openvdb::CoordBBox outer = region;
+        outer.expand(margin);
+        for (auto it = grid.tree().beginLeaf(); it; ++it)
+            if (outer.hasOverlap(it->getNodeBoundingBox())) leaves_.push_back(&*it);
+        std::unordered_map<openvdb::Coord, int> index;
+        for (std::size_t l = 0; l < leaves_.size(); ++l)
+            index[leaves_[l]->origin()] = int(l);
+        neighbours_.resize(leaves_.size());
+        for (std::size_t l = 0; l < leaves_.size(); ++l)
+            for (int a = 0; a < 3; ++a)
+                for (int d = 0; d < 2; ++d) {
+                    openvdb::Coord o = leaves_[l]->origin();
+                    o[a] += d ? Leaf::DIM : -int(Leaf::DIM);
+                    auto it = index.find(o);
+                    neighbours_[l][2 * a + d] = it == index.end() ? -1 : it->second;
+                }
+        phi.resize(size());
+        active.resize(size());
+        inRegion.resize(size());
+        tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+            const Leaf& leaf = *leaves_[l];
+            const bool whole = region.isInside(leaf.getNodeBoundingBox());
+            for (int off = 0; off < kLeafVoxels; ++off) {
+                const std::size_t i = (l << 9) + off;
+                phi[i] = leaf.getValue(off);
+                active[i] = leaf.isValueOn(off);
+                inRegion[i] = whole || region.isInside(leaf.offsetToGlobalCoord(off));
+            }
+        });
+    }
+
+    std::size_t size() const { return leaves_.size() * kLeafVoxels; }
+    std::size_t leafCount() const { return leaves_.size(); }
+    Leaf& leaf(std::size_t l) { return *leaves_[l]; }
+
+    std::size_t neighbour(std::size_t i, int a, int dir) const {
+        static constexpr int stride[3] = {64, 8, 1};
+        const int off = int(i & 511);
+        const int c = (off / stride[a]) & 7;
+        const int v = c + dir;
+        if (v >= 0 && v < 8) return dir > 0 ? i + stride[a] : i - stride[a];
+        const int nl = neighbours_[i >> 9][2 * a + (dir > 0)];
+        if (nl < 0) return npos;
+        return (std::size_t(nl) << 9) + off + (dir > 0 ? -7 : 7) * stride[a];
+    }
+
+    std::vector<float> phi;
+    std::vector<std::uint8_t> active, inRegion;
+
+  private:
+    openvdb::CoordBBox region_;
+    std::vector<Leaf*> leaves_;
+    std::vector<std::array<int, 6>> neighbours_;
 };
 
 bool negative(float v) {
@@ -105,47 +128,54 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
     const float h = float(grid.voxelSize()[0]);
     const float bg = grid.background();
     const float limit = bg; // march as far as the band reaches
-    Block b(grid, region, 2);
+    Domain b(grid, region, 2);
     const std::size_t n = b.size();
     std::vector<float> u(n, kInf);
     std::vector<std::uint8_t> state(n, Far);
 
     // Boundary voxels outside the region keep their values.
     for (std::size_t i = 0; i < n; ++i) {
-        if (b.inInner(i)) continue;
+        if (b.inRegion[i]) continue;
         state[i] = Fixed;
-        u[i] = std::abs(b.phi_[i]);
+        u[i] = std::abs(b.phi[i]);
+    }
+
+    // Thin voxels: the surface on both sides along some axis. Their central differences
+    // span the feature, and so do those of voxels up to two steps away, which are flagged
+    // too (ring 2 and 3).
+    std::vector<std::uint8_t> thin(n, 0);
+    auto forAll = [&](const auto& body) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const auto& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i)
+                body(i);
+        });
+    };
+    forAll([&](std::size_t i) {
+        const bool neg = negative(b.phi[i]);
+        for (int a = 0; a < 3 && !thin[i]; ++a) {
+            const std::size_t lo = b.neighbour(i, a, -1), hi = b.neighbour(i, a, 1);
+            thin[i] = lo != Domain::npos && hi != Domain::npos && negative(b.phi[lo]) != neg &&
+                      negative(b.phi[hi]) != neg;
+        }
+    });
+    for (std::uint8_t ring = 1; ring <= 2; ++ring) {
+        forAll([&](std::size_t i) {
+            if (thin[i]) return;
+            for (int a = 0; a < 3; ++a)
+                for (int dir : {-1, 1}) {
+                    const std::size_t j = b.neighbour(i, a, dir);
+                    if (j != Domain::npos && thin[j] == ring) thin[i] = ring + 1;
+                }
+        });
     }
 
     // 1. Seeds (voxels with a face neighbour across the surface): phi / |grad phi| with
     //    central differences, which turns a sampled field that is no longer a distance back
     //    into one to second order where the field is smooth, capped by the distance to the
     //    nearest axis crossing (the surface is no farther). The sign is always kept.
-    // Thin voxels: the surface on both sides along some axis.
-    // Their central differences span the feature, and so do those of voxels up to two
-    // steps away, so those are flagged too.
-    std::vector<std::uint8_t> thin(n, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-        const bool neg = negative(b.phi_[i]);
-        for (int a = 0; a < 3 && !thin[i]; ++a) {
-            const std::size_t lo = b.neighbour(i, a, -1), hi = b.neighbour(i, a, 1);
-            thin[i] = lo != Block::npos && hi != Block::npos && negative(b.phi_[lo]) != neg &&
-                      negative(b.phi_[hi]) != neg;
-        }
-    }
-    for (std::uint8_t ring = 1; ring <= 2; ++ring) {
-        for (std::size_t i = 0; i < n; ++i) {
-            if (thin[i] != ring) continue;
-            for (int a = 0; a < 3; ++a)
-                for (int dir : {-1, 1}) {
-                    const std::size_t j = b.neighbour(i, a, dir);
-                    if (j != Block::npos && !thin[j]) thin[j] = ring + 1;
-                }
-        }
-    }
-    for (std::size_t i = 0; i < n; ++i) {
-        if (state[i] == Fixed) continue;
-        const float p = b.phi_[i];
+    forAll([&](std::size_t i) {
+        if (state[i] == Fixed) return;
+        const float p = b.phi[i];
         double inv2 = 0.0, grad2 = 0.0;
         float nearestCrossing = kInf;
         bool crossing = false, central = true;
@@ -154,14 +184,14 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
             float side[2] = {p, p};
             for (int dir : {-1, 1}) {
                 const std::size_t j = b.neighbour(i, a, dir);
-                if (j == Block::npos) {
+                if (j == Domain::npos) {
                     central = false;
                     continue;
                 }
-                side[dir > 0] = b.phi_[j];
-                if (negative(b.phi_[j]) == negative(p)) continue;
+                side[dir > 0] = b.phi[j];
+                if (negative(b.phi[j]) == negative(p)) continue;
                 crossing = true;
-                const float q = b.phi_[j];
+                const float q = b.phi[j];
                 const float t = p / (p - q); // fraction of the edge to the crossing
                 best = std::min(best, std::max(t, 1e-6f));
             }
@@ -174,7 +204,7 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
             const double g = 0.5 * (double(side[1]) - side[0]);
             grad2 += g * g;
         }
-        if (!crossing) continue;
+        if (!crossing) return;
         // The surface is no farther than the nearest axis crossing; the plane through the
         // crossings is a first-order estimate below that.
         const bool nearThin = thin[i] != 0;
@@ -196,28 +226,30 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
         }
         u[i] = d;
         state[i] = Known;
-        ++stats.seeds;
-    }
+    });
+
+    for (std::size_t i = 0; i < n; ++i)
+        stats.seeds += state[i] == Known;
 
     // 2. March from every known or fixed voxel.
     using Item = std::pair<float, std::size_t>;
     std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
     auto update = [&](std::size_t i) {
-        const bool neg = negative(b.phi_[i]);
+        const bool neg = negative(b.phi[i]);
         float m[3], c[3];
         int k = 0;
         for (int a = 0; a < 3; ++a) {
             float best = kInf, second = kInf;
             for (int dir : {-1, 1}) {
                 const std::size_t j = b.neighbour(i, a, dir);
-                if (j == Block::npos || state[j] < Known || negative(b.phi_[j]) != neg) continue;
+                if (j == Domain::npos || state[j] < Known || negative(b.phi[j]) != neg) continue;
                 if (u[j] < best) {
                     best = u[j];
                     second = kInf;
                     if (order == FmmOrder::Second) {
                         const std::size_t j2 = b.neighbour(j, a, dir);
-                        if (j2 != Block::npos && state[j2] >= Known &&
-                            negative(b.phi_[j2]) == neg && u[j2] <= u[j])
+                        if (j2 != Domain::npos && state[j2] >= Known &&
+                            negative(b.phi[j2]) == neg && u[j2] <= u[j])
                             second = u[j2];
                     }
                 }
@@ -245,7 +277,7 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
         for (int a = 0; a < 3; ++a)
             for (int dir : {-1, 1}) {
                 const std::size_t j = b.neighbour(i, a, dir);
-                if (j != Block::npos && state[j] < Known) update(j);
+                if (j != Domain::npos && state[j] < Known) update(j);
             }
     }
     while (!heap.empty()) {
@@ -258,23 +290,25 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
         for (int a = 0; a < 3; ++a)
             for (int dir : {-1, 1}) {
                 const std::size_t j = b.neighbour(i, a, dir);
-                if (j != Block::npos && state[j] < Known) update(j);
+                if (j != Domain::npos && state[j] < Known) update(j);
             }
     }
 
-    // 3. Write back: inside the band active with the new distance, beyond it off.
-    auto acc = grid.getAccessor();
-    for (std::size_t i = 0; i < n; ++i) {
-        if (state[i] == Fixed) continue;
-        const bool neg = negative(b.phi_[i]);
-        const openvdb::Coord ijk = b.coord(i);
-        if (u[i] < bg) {
-            acc.setValueOn(ijk, neg ? -u[i] : u[i]);
-        } else {
-            const float off = neg ? -bg : bg;
-            if (b.active_[i] || b.phi_[i] != off) acc.setValueOff(ijk, off);
+    // 3. Write back: inside the band active with the new distance, beyond it off. Every
+    //    voxel lives in an existing leaf, so leaves are written in parallel.
+    tbb::parallel_for(std::size_t(0), b.leafCount(), [&](std::size_t l) {
+        Leaf& leaf = b.leaf(l);
+        for (int off = 0; off < kLeafVoxels; ++off) {
+            const std::size_t i = (l << 9) + off;
+            if (state[i] == Fixed) continue;
+            const bool neg = negative(b.phi[i]);
+            if (u[i] < bg) {
+                leaf.setValueOn(off, neg ? -u[i] : u[i]);
+            } else {
+                leaf.setValueOff(off, neg ? -bg : bg);
+            }
         }
-    }
+    });
     openvdb::tools::pruneLevelSet(grid.tree());
     return stats;
 }

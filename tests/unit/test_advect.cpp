@@ -67,7 +67,8 @@ struct Translated {
 // A ball tool enclosing the whole unit sphere (and its band) moves it by 20 voxels.
 Translated translateSphere(bool perSubStep) {
     const double h = 1.0 / 32;
-    const Eigen::Vector3d d = 20 * h * Eigen::Vector3d(0.6, 0.8, 0.0);
+    // 20 voxels along a direction that puts the result between lattice points.
+    const Eigen::Vector3d d = 20 * h * Eigen::Vector3d(0.48, 0.6, 0.64);
     GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
     Sweep sweep{{{std::make_shared<EllipsoidShape>(1.25), 0.4, {at({0, 0, 0}), at(d)}}}};
     const SweepSegment seg(sweep, 0);
