@@ -152,11 +152,11 @@ Eigen::Vector3d SweepSegment::inverseMap(const Eigen::Vector3d& p) const {
     return q;
 }
 
-ForwardResult SweepSegment::forwardStep(int k, const Eigen::Vector3d& q) const {
+ForwardResult SweepSegment::forwardStep(int k, const Eigen::Vector3d& q, double tolerance) const {
     // inverseStep(k, p) = exp(-B(p)) p = q  <=>  p = exp(B(p)) q: iterate on p. The map is
     // a contraction with factor at most bound / s < 1, which is what 3.19 guarantees.
     ForwardResult r{q, false, 0};
-    const double tol = options_.forwardTolerance * (1.0 + q.norm());
+    const double tol = (tolerance > 0.0 ? tolerance : options_.forwardTolerance) * (1.0 + q.norm());
     for (int it = 1; it <= options_.forwardMaxIterations; ++it) {
         const std::optional<MotionLog> b = stepBlend(k, r.p);
         const Eigen::Vector3d next = b ? b->applyExp(q) : q;

@@ -72,8 +72,9 @@ class SweepSegment {
     Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const;
     // Whole-segment inverse: inverse sub-steps s-1 down to 0.
     Eigen::Vector3d inverseMap(const Eigen::Vector3d& p) const;
-    // Forward sub-step k: the p with inverseStep(k, p) = q.
-    ForwardResult forwardStep(int k, const Eigen::Vector3d& q) const;
+    // Forward sub-step k: the p with inverseStep(k, p) = q, to `tolerance` (relative to
+    // 1 + |q|; the segment's forwardTolerance when 0).
+    ForwardResult forwardStep(int k, const Eigen::Vector3d& q, double tolerance = 0.0) const;
     // Whole-segment forward map: forward sub-steps 0 up to s-1.
     ForwardResult forwardMap(const Eigen::Vector3d& p) const;
 

@@ -81,6 +81,8 @@ AdvectStats advectSegment(Grid& grid, const SweepSegment& seg, const AdvectOptio
     const double h = grid.voxelSize()[0];
     const double halfWidth = halfWidthOf(grid);
     const openvdb::CoordBBox region = indexBox(grid, seg.affectedBox(), 1);
+    // The images only pick voxels to activate: a hundredth of a voxel is plenty.
+    const double forwardTolerance = 0.01 * h / (1.0 + seg.affectedBox().max.cwiseAbs().maxCoeff());
 
     // 1. Grow the band: forward-map the interface voxels, one sub-step at a time, and mark
     //    every image; also measure how far apart the images of neighbouring voxels land
@@ -107,7 +109,7 @@ AdvectStats advectSegment(Grid& grid, const SweepSegment& seg, const AdvectOptio
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             Eigen::Vector3d p = toEigen(grid.indexToWorld(interface[i]));
             for (int k = 0; k < seg.steps(); ++k) {
-                p = seg.forwardStep(k, p).p;
+                p = seg.forwardStep(k, p, forwardTolerance).p;
                 // Intermediate surfaces only need a band when they are stored.
                 if (options.resampleEachSubStep || k + 1 == seg.steps())
                     m.push_back(openvdb::Coord::round(grid.worldToIndex(toVdb(p))));

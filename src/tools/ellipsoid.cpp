@@ -34,6 +34,11 @@ class PlacedEllipsoid : public PlacedShape {
     double distance(const Eigen::Vector3d& p) const override {
         return distanceToFilledEllipsoid(a_, Ut_ * (p - c_));
     }
+    double distanceBelow(const Eigen::Vector3d& p, double cutoff) const override {
+        // |p - c| - (largest semi-axis) is a lower bound of the distance.
+        const double bound = (p - c_).norm() - a_.maxCoeff();
+        return bound >= cutoff ? bound : distance(p);
+    }
     Box bounds() const override { return {c_ - halfExtent_, c_ + halfExtent_}; }
 
   private:
@@ -79,7 +84,9 @@ double distanceToFilledEllipsoid(const Eigen::Vector3d& e, const Eigen::Vector3d
     // F is convex and decreasing on t >= 0 with F(0) > 0 (p is outside), so Newton's method
     // started at 0 climbs monotonically to the root without overshooting.
     const Eigen::Vector3d e2 = e.cwiseProduct(e);
-    double t = 0.0;
+    // At the root 1 >= e_min^2 |y|^2 / (t + e_max^2)^2, so t >= e_min |y| - e_max^2: starting
+    // there keeps Newton on the left of the root and saves most iterations far away.
+    double t = std::max(0.0, e.minCoeff() * y.norm() - e2.maxCoeff());
     for (int it = 0; it < 100; ++it) {
         double F = -1.0, dF = 0.0;
         for (int i = 0; i < 3; ++i) {

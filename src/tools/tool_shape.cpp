@@ -14,7 +14,7 @@ PlacedTool::PlacedTool(std::unique_ptr<PlacedShape> shape, double falloff)
 
 double PlacedTool::influence(const Eigen::Vector3d& p) const {
     if (!coating_.contains(p)) return 0.0;
-    return falloffMu(shape_->distance(p), falloff_);
+    return falloffMu(shape_->distanceBelow(p, falloff_), falloff_);
 }
 
 } // namespace sweepers

@@ -23,6 +23,11 @@ class PlacedShape {
     virtual ~PlacedShape() = default;
     // Euclidean world distance from p to the filled shape; 0 inside.
     virtual double distance(const Eigen::Vector3d& p) const = 0;
+    // The same where it is below `cutoff`; elsewhere any value >= cutoff. The falloff needs
+    // no more, and shapes use it to skip exact work far away.
+    virtual double distanceBelow(const Eigen::Vector3d& p, double /*cutoff*/) const {
+        return distance(p);
+    }
     // World box enclosing the shape.
     virtual Box bounds() const = 0;
 };
