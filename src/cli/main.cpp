@@ -54,7 +54,15 @@ int runCheck(const std::string& path, bool asJson) {
                      {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
             }
         } else {
-            out.push_back({{"stroke", i}, {"type", "swirl"}});
+            const SwirlSegment seg(toSwirl(std::get<SwirlStroke>(script.strokes[i])));
+            out.push_back(
+                {{"stroke", i},
+                 {"type", "swirl"},
+                 {"segment", 0},
+                 {"tools", 1},
+                 {"steps", seg.steps()},
+                 {"bound", 0.0},
+                 {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
         }
     }
     if (asJson) {
@@ -64,7 +72,8 @@ int runCheck(const std::string& path, bool asJson) {
     std::cout << path << ": valid, " << script.strokes.size() << " strokes\n";
     for (const auto& row : out) {
         if (row["type"] == "swirl") {
-            std::cout << "  stroke " << row["stroke"] << ": swirl\n";
+            std::cout << "  stroke " << row["stroke"] << ": swirl ring, " << row["steps"]
+                      << " sub-steps, affected box " << row["affected_box"].dump() << "\n";
             continue;
         }
         std::cout << "  stroke " << row["stroke"] << " segment " << row["segment"] << ": "
@@ -123,7 +132,6 @@ struct ApplyArgs {
 
 int runApply(const ApplyArgs& a) {
     const StrokeScript script = readStrokeScript(a.script);
-    requireApplicable(script, a.script);
     if (a.voxelSize != 0.0 && !(a.voxelSize > 0.0 && std::isfinite(a.voxelSize)))
         throw std::runtime_error("--voxel-size must be a positive number");
     if (!a.mesh.empty() && !isMeshPath(a.mesh))

@@ -53,8 +53,9 @@ std::size_t Sweep::segmentCount() const {
     return n - 1;
 }
 
-SweepSegment::SweepSegment(const Sweep& sweep, std::size_t index, const SegmentOptions& options)
-    : options_(options) {
+SweepSegment::SweepSegment(const Sweep& sweep, std::size_t index, const SegmentOptions& options) {
+    forwardTolerance_ = options.forwardTolerance;
+    forwardMaxIterations_ = options.forwardMaxIterations;
     if (index >= sweep.segmentCount()) throw std::invalid_argument("segment index out of range");
 
     // Each tool's start placement and motion log; a mirror adds the reflected tool, placed
@@ -120,7 +121,7 @@ SweepSegment::SweepSegment(const Sweep& sweep, std::size_t index, const SegmentO
     }
 }
 
-std::optional<MotionLog> SweepSegment::stepBlend(int k, const Eigen::Vector3d& p) const {
+std::optional<MotionLog> SweepSegment::stepLog(int k, const Eigen::Vector3d& p) const {
     if (!stepBoxes_[k].contains(p)) return std::nullopt;
     // Normalized blend 3.17 / 5.19: c = (1 - prod(1 - phi_j)) / sum(phi_j).
     double sum = 0.0, prod = 1.0;
@@ -137,50 +138,6 @@ std::optional<MotionLog> SweepSegment::stepBlend(int k, const Eigen::Vector3d& p
     if (active == 0) return std::nullopt;
     if (active == 1) return blend; // c phi = phi
     return blend * ((1.0 - prod) / sum);
-}
-
-Eigen::Vector3d SweepSegment::inverseStep(int k, const Eigen::Vector3d& p) const {
-    const std::optional<MotionLog> b = stepBlend(k, p);
-    return b ? (-*b).applyExp(p) : p;
-}
-
-Eigen::Vector3d SweepSegment::inverseMap(const Eigen::Vector3d& p) const {
-    if (!affected_.contains(p)) return p;
-    Eigen::Vector3d q = p;
-    for (int k = steps_ - 1; k >= 0; --k)
-        q = inverseStep(k, q);
-    return q;
-}
-
-ForwardResult SweepSegment::forwardStep(int k, const Eigen::Vector3d& q, double tolerance) const {
-    // inverseStep(k, p) = exp(-B(p)) p = q  <=>  p = exp(B(p)) q: iterate on p. The map is
-    // a contraction with factor at most bound / s < 1, which is what 3.19 guarantees.
-    ForwardResult r{q, false, 0};
-    const double tol = (tolerance > 0.0 ? tolerance : options_.forwardTolerance) * (1.0 + q.norm());
-    for (int it = 1; it <= options_.forwardMaxIterations; ++it) {
-        const std::optional<MotionLog> b = stepBlend(k, r.p);
-        const Eigen::Vector3d next = b ? b->applyExp(q) : q;
-        const double change = (next - r.p).norm();
-        r.p = next;
-        r.iterations = it;
-        if (change <= tol) {
-            r.converged = true;
-            break;
-        }
-    }
-    return r;
-}
-
-ForwardResult SweepSegment::forwardMap(const Eigen::Vector3d& p) const {
-    ForwardResult r{p, true, 0};
-    if (!affected_.contains(p)) return r;
-    for (int k = 0; k < steps_; ++k) {
-        const ForwardResult s = forwardStep(k, r.p);
-        r.p = s.p;
-        r.converged = r.converged && s.converged;
-        r.iterations = std::max(r.iterations, s.iterations);
-    }
-    return r;
 }
 
 } // namespace sweepers

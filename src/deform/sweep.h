@@ -20,6 +20,7 @@
 #include "core/box.h"
 #include "core/motion_log.h"
 #include "deform/placement.h"
+#include "deform/step_deformation.h"
 #include "tools/tool_shape.h"
 
 namespace sweepers {
@@ -47,39 +48,24 @@ struct SegmentOptions {
     int forwardMaxIterations = 500;
 };
 
-struct ForwardResult {
-    Eigen::Vector3d p;
-    bool converged = true;
-    int iterations = 0; // largest count over the sub-steps
-};
-
-class SweepSegment {
+class SweepSegment : public StepDeformation {
   public:
     // Plans segment `index` of the sweep. Throws std::invalid_argument for a malformed
     // sweep and std::domain_error for a motion without a logarithm.
     SweepSegment(const Sweep& sweep, std::size_t index, const SegmentOptions& options = {});
 
-    int steps() const { return steps_; }
     // The fold-over bound the step count was taken from (left side of 3.19).
     double stepBound() const { return stepBound_; }
-    // Outside this box every sub-step, and so the whole segment, is the identity.
-    const Box& affectedBox() const { return affected_; }
     // Tools after mirroring (a mirrored sweep has twice as many).
     std::size_t toolCount() const { return tools_.size(); }
     const MotionLog& motionLog(std::size_t tool) const { return tools_[tool].log; }
 
-    // Inverse of sub-step k (5.18 / 5.19).
-    Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const;
-    // Whole-segment inverse: inverse sub-steps s-1 down to 0.
-    Eigen::Vector3d inverseMap(const Eigen::Vector3d& p) const;
-    // Forward sub-step k: the p with inverseStep(k, p) = q, to `tolerance` (relative to
-    // 1 + |q|; the segment's forwardTolerance when 0).
-    ForwardResult forwardStep(int k, const Eigen::Vector3d& q, double tolerance = 0.0) const;
-    // Whole-segment forward map: forward sub-steps 0 up to s-1.
-    ForwardResult forwardMap(const Eigen::Vector3d& p) const;
-
     // Tool j at sub-step placement tau_k, k in [0, s].
     const PlacedTool& placedTool(std::size_t j, int k) const { return *tools_[j].placed[k]; }
+
+  protected:
+    // The normalized blend of sub-step k at p (tools at tau_{k+1}).
+    std::optional<MotionLog> stepLog(int k, const Eigen::Vector3d& p) const override;
 
   private:
     struct ToolPlan {
@@ -87,15 +73,9 @@ class SweepSegment {
         MotionLog stepLog;                               // log M_j / s
         std::vector<std::unique_ptr<PlacedTool>> placed; // k = 0..s
     };
-    // Blended log of sub-step k at p (tools at tau_{k+1}); nullopt where no tool reaches.
-    std::optional<MotionLog> stepBlend(int k, const Eigen::Vector3d& p) const;
-
     std::vector<ToolPlan> tools_;
     std::vector<Box> stepBoxes_; // union of coatings at tau_{k+1}
-    Box affected_;
-    int steps_ = 1;
     double stepBound_ = 0.0;
-    SegmentOptions options_;
 };
 
 // The reflection matrix of a mirror plane through the origin.

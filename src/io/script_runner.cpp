@@ -1,6 +1,7 @@
 #include "io/script_runner.h"
 
 #include <chrono>
+#include <memory>
 
 #include "io/mesh_file.h"
 #include "io/vdb_file.h"
@@ -47,34 +48,35 @@ GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir,
     return nullptr;
 }
 
-void requireApplicable(const StrokeScript& script, const std::string& name) {
-    for (std::size_t i = 0; i < script.strokes.size(); ++i)
-        if (std::holds_alternative<SwirlStroke>(script.strokes[i]))
-            throw ScriptError(name + ": /strokes/" + std::to_string(i) +
-                              ": swirl strokes are not supported by this build yet");
-}
-
 std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,
                                         const RunOptions& options, const Progress& progress,
                                         const std::function<void(std::size_t)>& after) {
-    std::vector<Sweep> sweeps;
+    // Every stroke as its list of deformations: a sweep's segments, or one swirl ring.
+    std::vector<std::vector<std::unique_ptr<StepDeformation>>> plans;
     std::size_t total = 0;
     for (const Stroke& s : script.strokes) {
-        sweeps.push_back(toSweep(std::get<SweepStroke>(s)));
-        total += sweeps.back().segmentCount();
+        plans.emplace_back();
+        if (const auto* sweep = std::get_if<SweepStroke>(&s)) {
+            const Sweep sw = toSweep(*sweep);
+            for (std::size_t k = 0; k < sw.segmentCount(); ++k)
+                plans.back().push_back(std::make_unique<SweepSegment>(sw, k));
+        } else {
+            plans.back().push_back(
+                std::make_unique<SwirlSegment>(toSwirl(std::get<SwirlStroke>(s))));
+        }
+        total += plans.back().size();
     }
     std::vector<SegmentReport> reports;
     std::size_t done = 0;
     SurfaceMesher mesher;
     if (options.remesh) mesher.rebuild(grid);
-    for (std::size_t i = 0; i < sweeps.size(); ++i) {
-        for (std::size_t k = 0; k < sweeps[i].segmentCount(); ++k) {
+    for (std::size_t i = 0; i < plans.size(); ++i) {
+        for (std::size_t k = 0; k < plans[i].size(); ++k) {
             const auto t0 = std::chrono::steady_clock::now();
-            const SweepSegment seg(sweeps[i], k);
             SegmentReport r;
             r.stroke = i;
             r.segment = k;
-            r.stats = advectSegment(grid, seg, options.advect);
+            r.stats = advectSegment(grid, *plans[i][k], options.advect);
             const auto t1 = std::chrono::steady_clock::now();
             r.seconds = std::chrono::duration<double>(t1 - t0).count();
             if (options.remesh) {

@@ -32,10 +32,6 @@ using Progress = std::function<void(std::size_t, std::size_t)>;
 GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir,
                       const RunOptions& options);
 
-// Throws ScriptError before touching the grid when the script holds strokes this build
-// cannot apply.
-void requireApplicable(const StrokeScript& script, const std::string& name);
-
 // Applies all strokes; calls `after` (if set) after each stroke with its index.
 std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,
                                         const RunOptions& options, const Progress& progress = {},

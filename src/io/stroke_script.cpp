@@ -180,6 +180,12 @@ SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
             r.fail(at + "/swirls", "expected a whole number from 1 to 1024");
         s.swirls = it->get<int>();
     }
+    if (s.move.norm() == 0.0) r.fail(at + "/move", "a swirl needs a non-zero move");
+    try {
+        SwirlSegment check(toSwirl(s));
+    } catch (const std::exception& e) {
+        r.fail(at, e.what());
+    }
     return s;
 }
 
@@ -367,6 +373,16 @@ std::string formatStrokeScript(const StrokeScript& s) {
 
 void writeStrokeScript(const StrokeScript& script, const std::string& path) {
     writeTextAtomically(path, formatStrokeScript(script));
+}
+
+SwirlSpec toSwirl(const SwirlStroke& stroke) {
+    SwirlSpec s;
+    s.at = stroke.at;
+    s.move = stroke.move;
+    s.radius = stroke.radius;
+    s.ring = stroke.ring == "convolution" ? SwirlRing::Convolution : SwirlRing::Discrete;
+    s.swirls = stroke.swirls;
+    return s;
 }
 
 Sweep toSweep(const SweepStroke& stroke) {

@@ -22,6 +22,7 @@
 
 #include "deform/placement.h"
 #include "deform/sweep.h"
+#include "deform/swirl.h"
 
 namespace sweepers {
 
@@ -83,5 +84,7 @@ void writeStrokeScript(const StrokeScript& script, const std::string& path);
 
 // The deformation a sweep stroke describes.
 Sweep toSweep(const SweepStroke& stroke);
+// The swirl ring a swirl stroke describes.
+SwirlSpec toSwirl(const SwirlStroke& stroke);
 
 } // namespace sweepers

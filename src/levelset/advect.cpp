@@ -75,7 +75,7 @@ openvdb::CoordBBox indexBox(const Grid& grid, const Box& world, int pad) {
                               openvdb::Coord::ceil(hi).offsetBy(pad));
 }
 
-AdvectStats advectSegment(Grid& grid, const SweepSegment& seg, const AdvectOptions& options) {
+AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOptions& options) {
     AdvectStats stats;
     stats.subSteps = seg.steps();
     const double h = grid.voxelSize()[0];

@@ -14,7 +14,7 @@
 // on the forward-mapped interface.
 #pragma once
 
-#include "deform/sweep.h"
+#include "deform/step_deformation.h"
 #include "levelset/fast_marching.h"
 #include "levelset/vdb.h"
 
@@ -35,7 +35,7 @@ struct AdvectStats {
     openvdb::CoordBBox touched; // index box whose values may have changed
 };
 
-AdvectStats advectSegment(Grid& grid, const SweepSegment& segment,
+AdvectStats advectSegment(Grid& grid, const StepDeformation& segment,
                           const AdvectOptions& options = {});
 
 // The index box of a world box, grown by `pad` voxels.

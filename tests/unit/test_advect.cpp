@@ -139,3 +139,36 @@ TEST(Advect, PinchOpensAHole) {
     EXPECT_TRUE(t.watertight());
     EXPECT_TRUE(t.consistentlyOriented());
 }
+
+TEST(Advect, SwirlsKeepVolumeWhereSweepsDoNot) {
+    // The 50-stroke swirl script against sweeps of a ball along the same moves.
+    const std::string path = std::string(SWEEPERS_DATA_DIR) + "/starfish_swirls.json";
+    const StrokeScript swirls = readStrokeScript(path);
+    StrokeScript sweeps = swirls;
+    sweeps.strokes.clear();
+    for (const Stroke& s : swirls.strokes) {
+        const auto& sw = std::get<SwirlStroke>(s);
+        ToolSpec tool;
+        tool.shape = "ball";
+        tool.size = Eigen::Vector3d::Constant(0.1);
+        tool.falloff = sw.radius;
+        tool.path = {at(sw.at), at(sw.at + sw.move)};
+        SweepStroke stroke;
+        stroke.tools.push_back(tool);
+        sweeps.strokes.emplace_back(stroke);
+    }
+    ASSERT_EQ(swirls.strokes.size(), 50u);
+    RunOptions options;
+    options.voxelSize = 1.0 / 128; // a unit sphere 256 voxels across
+    GridPtr a = makeStartGrid(swirls, SWEEPERS_DATA_DIR, options), b = a->deepCopy();
+    const double v0 = measureLevelSet(*a).volume;
+    applyStrokes(*a, swirls, options);
+    applyStrokes(*b, sweeps, options);
+    const double swirlDrift = (measureLevelSet(*a).volume - v0) / v0;
+    const double sweepDrift = (measureLevelSet(*b).volume - v0) / v0;
+    std::printf("[ volume ] 50 strokes at voxel size %g: swirls %+.3f%%, sweeps %+.3f%%\n",
+                options.voxelSize, 100 * swirlDrift, 100 * sweepDrift);
+    EXPECT_LT(std::abs(swirlDrift), 0.01);
+    EXPECT_GT(std::abs(sweepDrift), 10 * std::abs(swirlDrift));
+    EXPECT_EQ(topologicalEulerCharacteristic(*a), 2);
+}

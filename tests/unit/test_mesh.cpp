@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <openvdb/tools/LevelSetMeasure.h>
 
+#include "deform/sweep.h"
 #include "grids.h"
 #include "levelset/advect.h"
 #include "levelset/measure.h"

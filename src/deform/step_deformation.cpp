@@ -1,0 +1,52 @@
+#include "deform/step_deformation.h"
+
+#include <algorithm>
+
+namespace sweepers {
+
+Eigen::Vector3d StepDeformation::inverseStep(int k, const Eigen::Vector3d& p) const {
+    const std::optional<MotionLog> L = stepLog(k, p);
+    return L ? (-*L).applyExp(p) : p;
+}
+
+Eigen::Vector3d StepDeformation::inverseMap(const Eigen::Vector3d& p) const {
+    if (!affected_.contains(p)) return p;
+    Eigen::Vector3d q = p;
+    for (int k = steps_ - 1; k >= 0; --k)
+        q = inverseStep(k, q);
+    return q;
+}
+
+ForwardResult StepDeformation::forwardStep(int k, const Eigen::Vector3d& q,
+                                           double tolerance) const {
+    ForwardResult r{q, false, 0};
+    const double tol = (tolerance > 0.0 ? tolerance : forwardTolerance_) * (1.0 + q.norm());
+    for (int it = 1; it <= forwardMaxIterations_; ++it) {
+        const std::optional<MotionLog> L = stepLog(k, r.p);
+        const Eigen::Vector3d next = L ? L->applyExp(q) : q;
+        const double change = (next - r.p).norm();
+        r.p = next;
+        r.iterations = it;
+        if (change <= tol) {
+            r.converged = true;
+            break;
+        }
+    }
+    return r;
+}
+
+ForwardResult StepDeformation::forwardMap(const Eigen::Vector3d& p) const {
+    ForwardResult r{p, true, 0};
+    // Outside the box every inverse sub-step fixes p, and being one-to-one, no other point
+    // maps onto it: the forward map fixes it too.
+    if (!affected_.contains(p)) return r;
+    for (int k = 0; k < steps_; ++k) {
+        const ForwardResult s = forwardStep(k, r.p);
+        r.p = s.p;
+        r.converged = r.converged && s.converged;
+        r.iterations = std::max(r.iterations, s.iterations);
+    }
+    return r;
+}
+
+} // namespace sweepers

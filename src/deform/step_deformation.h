@@ -1,0 +1,53 @@
+// The common shape of every deformation the engine applies: s sub-steps, each defined by
+// the closed form of its inverse, p -> exp(-L_k(p)) . p (thesis 5.18, 5.19), with a box
+// outside which all of them are the identity. Sweeps (sweep.h) and swirl rings (swirl.h)
+// provide L_k; composing inverses, and the forward map by fixed-point iteration
+// (INVERTFASTER, 5.4.1), are shared here.
+#pragma once
+
+#include <optional>
+
+#include "core/box.h"
+#include "core/motion_log.h"
+
+namespace sweepers {
+
+struct ForwardResult {
+    Eigen::Vector3d p;
+    bool converged = true;
+    int iterations = 0; // largest count over the sub-steps
+};
+
+class StepDeformation {
+  public:
+    virtual ~StepDeformation() = default;
+
+    int steps() const { return steps_; }
+    // Outside this box every sub-step, and so the whole deformation, is the identity.
+    const Box& affectedBox() const { return affected_; }
+
+    // Inverse of sub-step k.
+    Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const;
+    // Whole inverse: inverse sub-steps s-1 down to 0.
+    Eigen::Vector3d inverseMap(const Eigen::Vector3d& p) const;
+    // Forward sub-step k: the p with inverseStep(k, p) = q, to `tolerance` (relative to
+    // 1 + |q|; forwardTolerance() when 0). inverseStep(k, p) = exp(-L(p)) p = q holds
+    // exactly when p = exp(L(p)) q, which is iterated on p: a contraction wherever the
+    // sub-step is fold-over free.
+    ForwardResult forwardStep(int k, const Eigen::Vector3d& q, double tolerance = 0.0) const;
+    // Whole forward map: forward sub-steps 0 up to s-1.
+    ForwardResult forwardMap(const Eigen::Vector3d& p) const;
+
+    double forwardTolerance() const { return forwardTolerance_; }
+
+  protected:
+    // L_k(p); nullopt where sub-step k leaves p in place.
+    virtual std::optional<MotionLog> stepLog(int k, const Eigen::Vector3d& p) const = 0;
+
+    int steps_ = 1;
+    Box affected_;
+    double forwardTolerance_ = 1e-12;
+    int forwardMaxIterations_ = 500;
+};
+
+} // namespace sweepers

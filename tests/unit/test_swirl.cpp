@@ -1,0 +1,103 @@
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+#include "deform/swirl.h"
+#include "random.h"
+
+using namespace sweepers;
+using sweepers::test::Rng;
+
+namespace {
+
+Eigen::Matrix3d jacobian(const std::function<Eigen::Vector3d(const Eigen::Vector3d&)>& f,
+                         const Eigen::Vector3d& p, double h) {
+    Eigen::Matrix3d J;
+    for (int a = 0; a < 3; ++a) {
+        Eigen::Vector3d e = Eigen::Vector3d::Zero();
+        e[a] = h;
+        J.col(a) = (f(p + e) - f(p - e)) / (2 * h);
+    }
+    return J;
+}
+
+} // namespace
+
+TEST(Swirl, BasicSwirlKeepsVolume) {
+    // A ring of one swirl moved in one sub-step is one basic swirl: a rotation about an
+    // axis through c by an angle that depends only on |p - c| (appendix B.1).
+    Rng rng(61);
+    for (int c = 0; c < 5; ++c) {
+        SwirlSpec spec;
+        spec.at = rng.vec(-1, 1);
+        spec.radius = rng.uniform(0.2, 0.5);
+        spec.move = rng.unit() * spec.radius * 0.2; // s = 1
+        spec.swirls = 1;
+        const SwirlSegment swirl(spec);
+        ASSERT_EQ(swirl.steps(), 1);
+        const Box& box = swirl.affectedBox();
+        double worst = 0.0;
+        for (int i = 0; i < 2000; ++i) {
+            const Eigen::Vector3d p = rng.inBox(box.min, box.max);
+            const double det =
+                jacobian([&](const Eigen::Vector3d& x) { return swirl.inverseStep(0, x); }, p, 1e-5)
+                    .determinant();
+            worst = std::max(worst, std::abs(det - 1.0));
+        }
+        EXPECT_LT(worst, 1e-6) << c;
+    }
+}
+
+TEST(Swirl, RingsMoveTheirCentreByTheMove) {
+    // 4.2 / B.12 for the discrete ring, 4.13 for the convolution ring.
+    Rng rng(62);
+    for (SwirlRing ring : {SwirlRing::Discrete, SwirlRing::Convolution}) {
+        for (int c = 0; c < 10; ++c) {
+            SwirlSpec spec;
+            spec.ring = ring;
+            spec.at = rng.vec(-1, 1);
+            spec.radius = rng.uniform(0.15, 0.4);
+            spec.move = rng.unit() * rng.uniform(0.05, 1.0);
+            const SwirlSegment swirl(spec);
+            const ForwardResult f = swirl.forwardMap(spec.at);
+            ASSERT_TRUE(f.converged);
+            const double err = (f.p - (spec.at + spec.move)).norm();
+            EXPECT_LT(err, 0.01 * spec.move.norm()) << int(ring) << " " << c;
+            // ... and the inverse brings the target back.
+            EXPECT_LT((swirl.inverseMap(spec.at + spec.move) - spec.at).norm(),
+                      0.01 * spec.move.norm());
+        }
+    }
+}
+
+TEST(Swirl, StepsAngleAndReachFollowTheThesis) {
+    SwirlSpec spec;
+    spec.radius = 0.3;
+    spec.move = {0, 0, 0.5};
+    const SwirlSegment d(spec);
+    EXPECT_EQ(d.steps(), 7);                                     // ceil(4 * 0.5 / 0.3), 4.3
+    EXPECT_NEAR(d.swirlAngle(), 2 * 0.5 / (8 * 0.3 * 7), 1e-15); // 4.2 per sub-step
+    spec.ring = SwirlRing::Convolution;
+    const SwirlSegment c(spec);
+    const double l = 1.2 * 0.3, r = 0.3;
+    EXPECT_NEAR(c.swirlAngle(), 0.5 * std::pow(l * l + r * r, 2) / (2 * std::pow(l, 4) * r) / 7,
+                1e-12);
+    EXPECT_NEAR(c.boundingRadius(), r * std::sqrt(std::sqrt(2 * M_PI * r / 1e-2) - 1),
+                1e-12); // 4.15
+    // Nothing moves outside the affected box.
+    const Eigen::Vector3d far(3, 3, 3);
+    EXPECT_EQ(d.inverseMap(far), far);
+    EXPECT_EQ(c.forwardMap(far).p, far);
+}
+
+TEST(Swirl, RefusesDegenerateRings) {
+    SwirlSpec spec;
+    EXPECT_THROW(SwirlSegment{spec}, std::invalid_argument); // no move
+    spec.move = {0, 0, 1};
+    spec.radius = 0.0;
+    EXPECT_THROW(SwirlSegment{spec}, std::invalid_argument);
+    spec.radius = 1e-6;
+    EXPECT_THROW(SwirlSegment{spec}, std::domain_error); // millions of sub-steps
+}
