@@ -53,16 +53,18 @@ int runCheck(const std::string& path, bool asJson) {
                      {"bound", seg.stepBound()},
                      {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
             }
-        } else {
-            const SwirlSegment seg(toSwirl(std::get<SwirlStroke>(script.strokes[i])));
+        } else if (const auto* swirl = std::get_if<SwirlStroke>(&script.strokes[i])) {
+            const SwirlSegment seg(toSwirl(*swirl));
             out.push_back(
                 {{"stroke", i},
-                 {"type", "swirl"},
+                 {"type", swirl->ball > 0 ? "star-shaped swirl" : "swirl"},
                  {"segment", 0},
                  {"tools", 1},
                  {"steps", seg.steps()},
                  {"bound", 0.0},
                  {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
+        } else {
+            out.push_back({{"stroke", i}, {"type", "inflate"}});
         }
     }
     if (asJson) {
@@ -71,9 +73,14 @@ int runCheck(const std::string& path, bool asJson) {
     }
     std::cout << path << ": valid, " << script.strokes.size() << " strokes\n";
     for (const auto& row : out) {
-        if (row["type"] == "swirl") {
-            std::cout << "  stroke " << row["stroke"] << ": swirl ring, " << row["steps"]
-                      << " sub-steps, affected box " << row["affected_box"].dump() << "\n";
+        if (row["type"] == "inflate") {
+            std::cout << "  stroke " << row["stroke"] << ": inflate (reaches the whole shape)\n";
+            continue;
+        }
+        if (row["type"] != "sweep") {
+            std::cout << "  stroke " << row["stroke"] << ": " << row["type"].get<std::string>()
+                      << ", " << row["steps"] << " sub-steps, affected box "
+                      << row["affected_box"].dump() << "\n";
             continue;
         }
         std::cout << "  stroke " << row["stroke"] << " segment " << row["segment"] << ": "

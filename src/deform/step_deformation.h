@@ -27,22 +27,26 @@ class StepDeformation {
     const Box& affectedBox() const { return affected_; }
 
     // Inverse of sub-step k.
-    Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const;
+    virtual Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const;
     // Whole inverse: inverse sub-steps s-1 down to 0.
     Eigen::Vector3d inverseMap(const Eigen::Vector3d& p) const;
     // Forward sub-step k: the p with inverseStep(k, p) = q, to `tolerance` (relative to
     // 1 + |q|; forwardTolerance() when 0). inverseStep(k, p) = exp(-L(p)) p = q holds
     // exactly when p = exp(L(p)) q, which is iterated on p: a contraction wherever the
     // sub-step is fold-over free.
-    ForwardResult forwardStep(int k, const Eigen::Vector3d& q, double tolerance = 0.0) const;
+    virtual ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
+                                      double tolerance = 0.0) const;
     // Whole forward map: forward sub-steps 0 up to s-1.
     ForwardResult forwardMap(const Eigen::Vector3d& p) const;
 
     double forwardTolerance() const { return forwardTolerance_; }
 
   protected:
-    // L_k(p); nullopt where sub-step k leaves p in place.
-    virtual std::optional<MotionLog> stepLog(int k, const Eigen::Vector3d& p) const = 0;
+    // L_k(p); nullopt where sub-step k leaves p in place. Deformations that are not of the
+    // form exp(-L(p)) p override inverseStep and forwardStep instead.
+    virtual std::optional<MotionLog> stepLog(int /*k*/, const Eigen::Vector3d& /*p*/) const {
+        return std::nullopt;
+    }
 
     int steps_ = 1;
     Box affected_;

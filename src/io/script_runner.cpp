@@ -3,6 +3,7 @@
 #include <chrono>
 #include <memory>
 
+#include "deform/inflate.h"
 #include "io/mesh_file.h"
 #include "io/vdb_file.h"
 #include "levelset/level_set.h"
@@ -51,32 +52,44 @@ GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir,
 std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,
                                         const RunOptions& options, const Progress& progress,
                                         const std::function<void(std::size_t)>& after) {
-    // Every stroke as its list of deformations: a sweep's segments, or one swirl ring.
-    std::vector<std::vector<std::unique_ptr<StepDeformation>>> plans;
+    // Segments per stroke: a sweep's segments, or one swirl ring or inflation.
     std::size_t total = 0;
-    for (const Stroke& s : script.strokes) {
-        plans.emplace_back();
+    for (const Stroke& s : script.strokes)
+        total += std::holds_alternative<SweepStroke>(s)
+                     ? toSweep(std::get<SweepStroke>(s)).segmentCount()
+                     : 1;
+    // The deformations of one stroke, planned when it comes: an inflation's reach is the
+    // shape as it is then.
+    auto plan = [&](const Stroke& s) {
+        std::vector<std::unique_ptr<StepDeformation>> parts;
+        const Box reach = activeWorldBox(grid).expanded(2 * grid.voxelSize()[0]);
         if (const auto* sweep = std::get_if<SweepStroke>(&s)) {
             const Sweep sw = toSweep(*sweep);
             for (std::size_t k = 0; k < sw.segmentCount(); ++k)
-                plans.back().push_back(std::make_unique<SweepSegment>(sw, k));
+                parts.push_back(std::make_unique<SweepSegment>(sw, k));
+        } else if (const auto* swirl = std::get_if<SwirlStroke>(&s)) {
+            if (swirl->ball > 0.0)
+                parts.push_back(starShapedSwirl(toSwirl(*swirl), swirl->ball, reach));
+            else
+                parts.push_back(std::make_unique<SwirlSegment>(toSwirl(*swirl)));
         } else {
-            plans.back().push_back(
-                std::make_unique<SwirlSegment>(toSwirl(std::get<SwirlStroke>(s))));
+            const auto& in = std::get<InflateStroke>(s);
+            parts.push_back(std::make_unique<Inflation>(in.at, in.radius, reach));
         }
-        total += plans.back().size();
-    }
+        return parts;
+    };
     std::vector<SegmentReport> reports;
     std::size_t done = 0;
     SurfaceMesher mesher;
     if (options.remesh) mesher.rebuild(grid);
-    for (std::size_t i = 0; i < plans.size(); ++i) {
-        for (std::size_t k = 0; k < plans[i].size(); ++k) {
+    for (std::size_t i = 0; i < script.strokes.size(); ++i) {
+        const auto parts = plan(script.strokes[i]);
+        for (std::size_t k = 0; k < parts.size(); ++k) {
             const auto t0 = std::chrono::steady_clock::now();
             SegmentReport r;
             r.stroke = i;
             r.segment = k;
-            r.stats = advectSegment(grid, *plans[i][k], options.advect);
+            r.stats = advectSegment(grid, *parts[k], options.advect);
             const auto t1 = std::chrono::steady_clock::now();
             r.seconds = std::chrono::duration<double>(t1 - t0).count();
             if (options.remesh) {

@@ -165,7 +165,7 @@ SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
 }
 
 SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"type", "at", "move", "radius", "ring", "swirls"});
+    r.onlyKeys(v, at, {"type", "at", "move", "radius", "ring", "swirls", "ball"});
     SwirlStroke s;
     s.at = r.vec3(r.require(v, at, "at"), at + "/at");
     s.move = r.vec3(r.require(v, at, "move"), at + "/move");
@@ -180,12 +180,21 @@ SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
             r.fail(at + "/swirls", "expected a whole number from 1 to 1024");
         s.swirls = it->get<int>();
     }
+    if (auto it = v.find("ball"); it != v.end()) s.ball = r.positive(*it, at + "/ball");
     if (s.move.norm() == 0.0) r.fail(at + "/move", "a swirl needs a non-zero move");
     try {
         SwirlSegment check(toSwirl(s));
     } catch (const std::exception& e) {
         r.fail(at, e.what());
     }
+    return s;
+}
+
+InflateStroke readInflate(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"type", "at", "radius"});
+    InflateStroke s;
+    s.at = r.vec3(r.require(v, at, "at"), at + "/at");
+    s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
     return s;
 }
 
@@ -303,8 +312,11 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name)
             s.strokes.emplace_back(readSweep(r, v, at));
         else if (type == "swirl")
             s.strokes.emplace_back(readSwirl(r, v, at));
+        else if (type == "inflate")
+            s.strokes.emplace_back(readInflate(r, v, at));
         else
-            r.fail(at + "/type", "unknown stroke type \"" + type + "\" (expected sweep or swirl)");
+            r.fail(at + "/type",
+                   "unknown stroke type \"" + type + "\" (expected sweep, swirl or inflate)");
     }
     return s;
 }
@@ -356,14 +368,19 @@ std::string formatStrokeScript(const StrokeScript& s) {
                 tools.push_back(tj);
             }
             j["tools"] = tools;
-        } else {
-            const auto& sr = std::get<SwirlStroke>(stroke);
+        } else if (const auto* sr = std::get_if<SwirlStroke>(&stroke)) {
             j["type"] = "swirl";
-            j["at"] = vecJson(sr.at);
-            j["move"] = vecJson(sr.move);
-            j["radius"] = sr.radius;
-            j["ring"] = sr.ring;
-            j["swirls"] = sr.swirls;
+            j["at"] = vecJson(sr->at);
+            j["move"] = vecJson(sr->move);
+            j["radius"] = sr->radius;
+            j["ring"] = sr->ring;
+            j["swirls"] = sr->swirls;
+            if (sr->ball > 0.0) j["ball"] = sr->ball;
+        } else {
+            const auto& in = std::get<InflateStroke>(stroke);
+            j["type"] = "inflate";
+            j["at"] = vecJson(in.at);
+            j["radius"] = in.radius;
         }
         strokes.push_back(j);
     }

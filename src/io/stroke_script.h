@@ -5,7 +5,8 @@
 //     "start": { "sphere": { "center": [0,0,0], "radius": 1 } }   | {"vdb": F} | {"mesh": F}
 //     "strokes": [ { "type": "sweep", "mirror": "x", "tools": [ {shape, size, falloff, path} ] },
 //                  { "type": "swirl", "at": [..], "move": [..], "radius": r,
-//                    "ring": "discrete" | "convolution", "swirls": 8 } ] }
+//                    "ring": "discrete" | "convolution", "swirls": 8, "ball": rho },
+//                  { "type": "inflate", "at": [..], "radius": rho } ] }
 //
 // Reading validates everything, including that every segment's motion has a logarithm,
 // and refuses the whole script on the first problem with a ScriptError whose message
@@ -62,9 +63,15 @@ struct SwirlStroke {
     double radius = 0.3;
     std::string ring = "discrete"; // "discrete" | "convolution"
     int swirls = 8;
+    double ball = 0.0; // > 0: star-shaped swirl carrying a ball of this radius (4.19)
 };
 
-using Stroke = std::variant<SweepStroke, SwirlStroke>;
+struct InflateStroke {
+    Eigen::Vector3d at = Eigen::Vector3d::Zero();
+    double radius = 0.1;
+};
+
+using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke>;
 
 struct StrokeScript {
     int version = 1;

@@ -17,7 +17,7 @@ namespace sweepers {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr double kUnitSlack = 0.05;
+constexpr double kUnitSlack = 0.01;
 
 enum State : std::uint8_t { Far = 0, Trial = 1, Known = 2, Fixed = 3 };
 

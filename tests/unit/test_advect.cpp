@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "deform/inflate.h"
 #include "io/script_runner.h"
 #include "levelset/advect.h"
 #include "levelset/level_set.h"
@@ -171,4 +172,28 @@ TEST(Advect, SwirlsKeepVolumeWhereSweepsDoNot) {
     EXPECT_LT(std::abs(swirlDrift), 0.01);
     EXPECT_GT(std::abs(sweepDrift), 10 * std::abs(swirlDrift));
     EXPECT_EQ(topologicalEulerCharacteristic(*a), 2);
+}
+
+TEST(Advect, InflationAddsTheBallInsideAndKeepsVolumeOutside) {
+    // Decaudin's inflate (2.30, 2.31): a ball blown up inside the shape adds its volume,
+    // outside it only pushes the shape aside. Volumes from the welded mesh.
+    const double h = 1.0 / 64, rho = 0.3;
+    const double ball = 4.0 / 3.0 * M_PI * rho * rho * rho;
+    for (const Eigen::Vector3d& c : {Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d(1.45, 0.1, 0)}) {
+        GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+        const double v0 = enclosedVolume(meshLevelSet(*g));
+        const Inflation inflate(c, rho, activeWorldBox(*g).expanded(2 * h));
+        advectSegment(*g, inflate);
+        const TriangleMesh mesh = meshLevelSet(*g);
+        const double added = enclosedVolume(mesh) - v0;
+        const bool inside = c.norm() < 1.0;
+        std::printf("[ inflate ] centre %s: volume %+.5f (ball %.5f)\n",
+                    inside ? "inside" : "outside", added, ball);
+        if (inside) {
+            EXPECT_NEAR(added, ball, 0.02 * ball);
+        } else {
+            EXPECT_NEAR(added, 0.0, 0.01 * v0);
+        }
+        EXPECT_TRUE(meshTopology(mesh).watertight());
+    }
 }

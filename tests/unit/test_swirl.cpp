@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include "deform/inflate.h"
 #include "deform/swirl.h"
 #include "random.h"
 
@@ -100,4 +101,47 @@ TEST(Swirl, RefusesDegenerateRings) {
     EXPECT_THROW(SwirlSegment{spec}, std::invalid_argument);
     spec.radius = 1e-6;
     EXPECT_THROW(SwirlSegment{spec}, std::domain_error); // millions of sub-steps
+}
+
+TEST(Inflation, ExactInverseAndVolumeOutsideTheBall) {
+    Rng rng(63);
+    const Eigen::Vector3d c(0.2, -0.1, 0.3);
+    const double rho = 0.25;
+    const Inflation inflate(c, rho,
+                            Box(Eigen::Vector3d::Constant(-3), Eigen::Vector3d::Constant(3)));
+    for (int i = 0; i < 2000; ++i) {
+        const Eigen::Vector3d p = rng.vec(-2, 2);
+        const Eigen::Vector3d q = inflate.forwardMap(p).p;
+        EXPECT_LT((inflate.inverseMap(q) - p).norm(), 1e-12); // 2.31 undoes 2.30 exactly
+        EXPECT_GE((q - c).norm(), rho - 1e-12);               // nothing lands in the ball
+        const double det =
+            jacobian([&](const Eigen::Vector3d& x) { return inflate.forwardMap(x).p; }, p, 1e-6)
+                .determinant();
+        if ((p - c).norm() > 0.05) {
+            EXPECT_NEAR(det, 1.0, 1e-5); // volume kept outside c
+        }
+    }
+    // Inside the ball the inverse has no pre-image but the centre.
+    EXPECT_EQ(inflate.inverseMap(c + Eigen::Vector3d(0.1, 0, 0)), c);
+}
+
+TEST(Inflation, StarShapedSwirlCarriesTheBall) {
+    SwirlSpec spec;
+    spec.at = {0, 0, 0.5};
+    spec.move = {0, 0.3, 0};
+    spec.radius = 0.3;
+    const double rho = 0.1;
+    const auto star = starShapedSwirl(
+        spec, rho, Box(Eigen::Vector3d::Constant(-2), Eigen::Vector3d::Constant(2)));
+    // A point on the ball's surface at the start ends on the ball's surface at the end.
+    const Eigen::Vector3d p = spec.at + Eigen::Vector3d(rho, 0, 0) * 1.0001;
+    const Eigen::Vector3d q = star->forwardMap(p).p;
+    EXPECT_NEAR((q - (spec.at + spec.move)).norm(), rho, 0.02 * rho);
+    // Away from the ball the composition is undone by its inverse.
+    Rng rng(64);
+    for (int i = 0; i < 200; ++i) {
+        const Eigen::Vector3d x = rng.vec(-1, 1);
+        if ((x - spec.at).norm() < 2 * rho) continue;
+        EXPECT_LT((star->inverseMap(star->forwardMap(x).p) - x).norm(), 1e-6);
+    }
 }

@@ -1,0 +1,77 @@
+#include "deform/inflate.h"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace sweepers {
+
+Inflation::Inflation(const Eigen::Vector3d& centre, double radius, const Box& reach, bool remove)
+    : c_(centre), rho3_(radius * radius * radius), remove_(remove) {
+    if (!(radius > 0.0) || !std::isfinite(radius))
+        throw std::invalid_argument("an inflation needs a positive radius");
+    steps_ = 1;
+    affected_ = reach;
+    affected_.add(Box(centre.array() - 2 * radius, centre.array() + 2 * radius));
+}
+
+Eigen::Vector3d Inflation::blowUp(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d u = p - c_;
+    const double r = u.norm();
+    if (r == 0.0) return p; // the discontinuous point
+    return c_ + std::cbrt(r * r * r + rho3_) / r * u;
+}
+
+Eigen::Vector3d Inflation::suckIn(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d u = p - c_;
+    const double r = u.norm();
+    const double r3 = r * r * r;
+    if (r3 <= rho3_) return c_; // inside the ball: no pre-image but the centre
+    return c_ + std::cbrt(r3 - rho3_) / r * u;
+}
+
+Eigen::Vector3d Inflation::inverseStep(int, const Eigen::Vector3d& p) const {
+    if (!affected_.contains(p)) return p;
+    return remove_ ? blowUp(p) : suckIn(p);
+}
+
+ForwardResult Inflation::forwardStep(int, const Eigen::Vector3d& q, double) const {
+    if (!affected_.contains(q)) return {q, true, 0};
+    return {remove_ ? suckIn(q) : blowUp(q), true, 1};
+}
+
+Sequence::Sequence(std::vector<std::unique_ptr<StepDeformation>> parts) : parts_(std::move(parts)) {
+    steps_ = 0;
+    for (const auto& p : parts_) {
+        steps_ += p->steps();
+        affected_.add(p->affectedBox());
+    }
+}
+
+std::pair<const StepDeformation*, int> Sequence::locate(int k) const {
+    for (const auto& p : parts_) {
+        if (k < p->steps()) return {p.get(), k};
+        k -= p->steps();
+    }
+    throw std::out_of_range("sub-step out of range");
+}
+
+Eigen::Vector3d Sequence::inverseStep(int k, const Eigen::Vector3d& p) const {
+    const auto [part, local] = locate(k);
+    return part->inverseStep(local, p);
+}
+
+ForwardResult Sequence::forwardStep(int k, const Eigen::Vector3d& q, double tolerance) const {
+    const auto [part, local] = locate(k);
+    return part->forwardStep(local, q, tolerance);
+}
+
+std::unique_ptr<StepDeformation> starShapedSwirl(const SwirlSpec& swirl, double rho,
+                                                 const Box& reach) {
+    std::vector<std::unique_ptr<StepDeformation>> parts;
+    parts.push_back(std::make_unique<Inflation>(swirl.at, rho, reach, /*remove=*/true));
+    parts.push_back(std::make_unique<SwirlSegment>(swirl));
+    parts.push_back(std::make_unique<Inflation>(swirl.at + swirl.move, rho, reach));
+    return std::make_unique<Sequence>(std::move(parts));
+}
+
+} // namespace sweepers
