@@ -134,7 +134,7 @@ void exportMesh(const Grid& grid, const std::string& path) {
 struct ApplyArgs {
     std::string script, output, mesh;
     double voxelSize = 0.0;
-    bool perSubStep = false, quiet = false, firstOrder = false, stats = false;
+    bool perSubStep = false, quiet = false, firstOrder = false, stats = false, cubic = false;
 };
 
 int runApply(const ApplyArgs& a) {
@@ -151,6 +151,7 @@ int runApply(const ApplyArgs& a) {
     options.advect.resampleEachSubStep = a.perSubStep;
     options.advect.renormalization = a.firstOrder ? FmmOrder::First : FmmOrder::Second;
     options.remesh = a.stats;
+    options.advect.sampling = a.cubic ? Sampling::MonotoneCubic : Sampling::Trilinear;
     const GridPtr grid = makeStartGrid(script, directoryOf(a.script), options);
     const double before = measureLevelSet(*grid).volume;
     const auto reports =
@@ -221,6 +222,8 @@ int main(int argc, char** argv) {
     apply->add_flag("--resample-each-substep", applyArgs.perSubStep,
                     "Resample after every sub-step (the thesis's 5.3.4; blurrier)");
     apply->add_flag("--first-order", applyArgs.firstOrder, "First-order fast marching");
+    apply->add_flag("--monotone-cubic", applyArgs.cubic,
+                    "Resample with the monotone cubic of appendix C.1 instead of trilinear");
     apply->add_flag("-q,--quiet", applyArgs.quiet, "No progress output");
     apply->add_flag("--stats", applyArgs.stats,
                     "Print a table of per-segment timings (band growth, sampling, "

@@ -1,4 +1,5 @@
 #include "levelset/advect.h"
+#include "levelset/monotone_cubic.h"
 
 #include <chrono>
 #include <cmath>
@@ -39,14 +40,14 @@ bool hasCrossing(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk, floa
 
 // Resamples every active voxel of `grid` inside `box` from `source` at map(x).
 template <typename Map>
-std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& box,
-                     const Map& map) {
+std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& box, const Map& map,
+                     Sampling sampling) {
     openvdb::tree::LeafManager<Grid::TreeType> leaves(grid.tree());
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
     tbb::parallel_for(leaves.leafRange(), [&](const auto& range) {
         Grid::ConstAccessor acc = source.getConstAccessor();
-        openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
+        openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> trilinear(
             acc, source.transform());
         std::size_t n = 0;
         for (auto leaf = range.begin(); leaf; ++leaf) {
@@ -54,9 +55,10 @@ std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& b
             for (auto it = leaf->beginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
                 if (!box.isInside(ijk)) continue;
-                const Eigen::Vector3d x = toEigen(xform.indexToWorld(ijk));
-                const Eigen::Vector3d p = map(x);
-                it.setValue(float(sampler.wsSample(toVdb(p))));
+                const openvdb::Vec3d p = toVdb(map(toEigen(xform.indexToWorld(ijk))));
+                it.setValue(float(sampling == Sampling::Trilinear
+                                      ? trilinear.wsSample(p)
+                                      : sampleMonotoneCubic(acc, source.worldToIndex(p))));
                 ++n;
             }
         }
@@ -171,14 +173,15 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     t0 = Clock::now();
     if (!options.resampleEachSubStep) {
         if (!source) source = grid.deepCopy();
-        stats.sampledVoxels = resample(grid, *source, region,
-                                       [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); });
+        stats.sampledVoxels = resample(
+            grid, *source, region, [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); },
+            options.sampling);
     } else {
         for (int k = 0; k < seg.steps(); ++k) {
             GridPtr step = (k == 0 && source) ? source : grid.deepCopy();
-            stats.sampledVoxels += resample(grid, *step, region, [&](const Eigen::Vector3d& x) {
-                return seg.inverseStep(k, x);
-            });
+            stats.sampledVoxels += resample(
+                grid, *step, region,
+                [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling);
         }
     }
     // Voxels inside the region that are not in the band kept their old inactive values,

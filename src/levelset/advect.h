@@ -20,8 +20,11 @@
 
 namespace sweepers {
 
+enum class Sampling { Trilinear, MonotoneCubic };
+
 struct AdvectOptions {
-    bool resampleEachSubStep = false; // the thesis's 5.3.4 variant
+    bool resampleEachSubStep = false;        // the thesis's 5.3.4 variant
+    Sampling sampling = Sampling::Trilinear; // or the monotone cubic of appendix C.1
     FmmOrder renormalization = FmmOrder::Second;
     bool renormalize = true;
 };
