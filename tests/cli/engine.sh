@@ -44,6 +44,23 @@ PY
 "$cli" mesh "$tmp/horn.vdb" -o "$tmp/horn.obj" 2>/dev/null
 grep -q "^f " "$tmp/horn.obj" || fail "mesh wrote no faces"
 
+# --- scripts may start from a VDB or a mesh (paths relative to the script) -----------
+mkdir "$tmp/starts"
+cp "$tmp/sphere.vdb" "$tmp/starts/ball.vdb"
+"$cli" mesh "$tmp/sphere.vdb" -o "$tmp/starts/ball.obj" 2>/dev/null
+for start in '{"vdb": "ball.vdb"}' '{"mesh": "ball.obj"}'; do
+  printf '{"sweepers": 1, "grid": {"voxel_size": 0.025}, "start": %s, "strokes": [{"type": "inflate", "at": [0, 0, 0], "radius": 0.2}]}' "$start" >"$tmp/starts/s.json"
+  "$cli" apply "$tmp/starts/s.json" -o "$tmp/starts/out.vdb" -q || fail "start $start"
+  "$cli" info --json "$tmp/starts/out.vdb" >"$tmp/starts/info.json"
+  "$py" - "$tmp/starts/info.json" <<'PY' || fail "start $start: wrong volume"
+import json, math, sys
+info = json.load(open(sys.argv[1]))
+# a ball of radius 0.5 with a ball of radius 0.2 blown up inside it
+expected = 4 / 3 * math.pi * (0.5 ** 3 + 0.2 ** 3)
+assert abs(info["volume"] - expected) < 0.03 * expected, (info["volume"], expected)
+PY
+done
+
 # --- the same script gives identical grids on 1 and 2 threads ------------------------
 "$cli" --threads 1 apply "$data/twisted_limb.json" -o "$tmp/t1.vdb" --voxel-size 0.03125 -q
 "$cli" --threads 2 apply "$data/twisted_limb.json" -o "$tmp/t2.vdb" --voxel-size 0.03125 -q
