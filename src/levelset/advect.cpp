@@ -1,4 +1,5 @@
 #include "levelset/advect.h"
+#include "levelset/level_set.h"
 #include "levelset/monotone_cubic.h"
 
 #include <chrono>
@@ -26,16 +27,6 @@ using Clock = std::chrono::steady_clock;
 constexpr std::size_t kStretchSampling = 4;
 double since(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
-}
-
-bool hasCrossing(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk, float v) {
-    for (int a = 0; a < 3; ++a)
-        for (int d : {-1, 1}) {
-            openvdb::Coord n = ijk;
-            n[a] += d;
-            if ((acc.getValue(n) < 0.0f) != (v < 0.0f)) return true;
-        }
-    return false;
 }
 
 // Resamples every active voxel of `grid` inside `box` from `source` at map(x).
@@ -97,7 +88,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             if (!region.hasOverlap(leaf->getNodeBoundingBox())) continue;
             for (auto it = leaf->cbeginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
-                if (region.isInside(ijk) && hasCrossing(acc, ijk, *it)) interface.push_back(ijk);
+                if (region.isInside(ijk) && nextToCrossing(acc, ijk, *it)) interface.push_back(ijk);
             }
         }
     }

@@ -62,6 +62,16 @@ void markAsDocument(Grid& grid) {
     grid.insertMeta("half_width", openvdb::FloatMetadata(float(halfWidthOf(grid))));
 }
 
+bool nextToCrossing(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk, float v) {
+    for (int a = 0; a < 3; ++a)
+        for (int d : {-1, 1}) {
+            openvdb::Coord n = ijk;
+            n[a] += d;
+            if ((acc.getValue(n) < 0.0f) != (v < 0.0f)) return true;
+        }
+    return false;
+}
+
 BandReport checkBand(const Grid& grid) {
     BandReport r;
     openvdb::tools::CheckLevelSet<Grid> check(grid);

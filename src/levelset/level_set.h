@@ -31,6 +31,10 @@ GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
 // Names the grid "surface" and stamps the metadata of the file contract.
 void markAsDocument(Grid& grid);
 
+// True when a face neighbour of voxel ijk (value v) lies on the other side of the surface:
+// the voxel is next to the zero crossing.
+bool nextToCrossing(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk, float v);
+
 struct BandReport {
     std::size_t activeVoxels = 0;
     std::size_t nearInterface = 0; // active voxels within one voxel of the zero crossing

@@ -56,6 +56,10 @@ inline Eigen::Matrix4d seriesExp(const Eigen::Matrix4d& L) {
     return sum;
 }
 
+inline double maxDiff(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
+    return (a - b).cwiseAbs().maxCoeff();
+}
+
 inline Eigen::Vector3d apply(const Eigen::Matrix4d& M, const Eigen::Vector3d& p) {
     return M.topLeftCorner<3, 3>() * p + M.topRightCorner<3, 1>();
 }

@@ -40,13 +40,7 @@ double interfaceRms(const Grid& g, const std::function<double(const Eigen::Vecto
     double sum2 = 0.0;
     std::size_t n = 0;
     for (auto it = g.cbeginValueOn(); it; ++it) {
-        bool near = false;
-        for (int a = 0; a < 3; ++a)
-            for (int d : {-1, 1}) {
-                openvdb::Coord c = it.getCoord();
-                c[a] += d;
-                near = near || ((acc.getValue(c) < 0) != (*it < 0));
-            }
+        const bool near = nextToCrossing(acc, it.getCoord(), *it);
         if (!near) continue;
         const double e = (*it - sdf(toEigen(g.indexToWorld(it.getCoord())))) / h;
         sum2 += e * e;

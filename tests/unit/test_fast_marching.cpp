@@ -28,13 +28,7 @@ Errors compare(const Grid& g, const std::function<double(const Eigen::Vector3d&)
         const double err = std::abs(*it - exact) / h;
         if ((*it < 0) != (exact < 0)) ++e.signFlips;
         e.maxBand = std::max(e.maxBand, err);
-        bool nearCrossing = false;
-        for (int a = 0; a < 3; ++a)
-            for (int d : {-1, 1}) {
-                openvdb::Coord n = it.getCoord();
-                n[a] += d;
-                nearCrossing = nearCrossing || ((acc.getValue(n) < 0) != (*it < 0));
-            }
+        const bool nearCrossing = nextToCrossing(acc, it.getCoord(), *it);
         if (!nearCrossing) continue;
         ++e.near;
         e.maxNear = std::max(e.maxNear, err);

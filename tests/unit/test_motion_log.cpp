@@ -8,14 +8,11 @@
 
 using namespace sweepers;
 using sweepers::test::apply;
+using sweepers::test::maxDiff;
 using sweepers::test::Rng;
 using sweepers::test::seriesExp;
 
 namespace {
-
-double maxDiff(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
-    return (a - b).cwiseAbs().maxCoeff();
-}
 
 // Appendix A.2.2: S = T_c S_s T_-c.
 Eigen::Matrix4d scaleAbout(double s, const Eigen::Vector3d& c) {

@@ -7,14 +7,11 @@
 
 using namespace sweepers;
 using sweepers::test::apply;
+using sweepers::test::maxDiff;
 using sweepers::test::Rng;
 using sweepers::test::seriesExp;
 
 namespace {
-
-double maxDiff(const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
-    return (a - b).cwiseAbs().maxCoeff();
-}
 
 std::vector<Twist> sampleTwists() {
     Rng rng(7);
