@@ -1,17 +1,20 @@
-// Semi-Lagrangian advection of a level set through one sweep segment (thesis 5.3.3).
+// Semi-Lagrangian advection of a level set through one deformation (thesis 5.3.3): a
+// sweep segment, a swirl ring, an inflation.
 //
-// The new value at a voxel x is the old grid sampled at the segment's inverse map
-// f^-1(x), composed from all inverse sub-steps before a single trilinear sample: the
-// thesis's algorithm (5.3.4) resamples after every sub-step, which blurs the shape s
-// times; that variant is kept as an option so the difference can be measured.
+// The new value at a voxel x is the old grid sampled at the deformation's inverse map
+// f^-1(x), composed from all inverse sub-steps before a single sample (trilinear, or the
+// monotone cubic of appendix C.1): the thesis's algorithm (5.3.4) resamples after every
+// sub-step, which blurs the shape s times; that variant is kept as an option so the
+// difference can be measured.
 //
-// Only the affected box of the segment is touched. Before sampling, the band is grown
-// where the surface moves: the interface voxels are forward-mapped sub-step by sub-step
-// and the band is activated around every image, so the new surface always lies on active
-// voxels. Strongly compressing motions could send the pre-image of a voxel next to the new
-// surface outside the old band, where the old grid only holds +-background: the band is
-// widened first (by fast marching) to cover the stretch the segment can produce, measured
-// on the forward-mapped interface.
+// Only the affected box is touched. Before sampling, the band is grown where the surface
+// moves: the interface voxels are forward-mapped and the band is activated around their
+// images, so the new surface always lies on active voxels. Strongly compressing motions
+// could send the pre-image of a voxel next to the new surface outside the old band, where
+// the old grid only holds +-background: the source band is then widened first (by fast
+// marching, inside the affected box) to cover the stretch of the inverse map, measured on
+// the forward-mapped interface. After sampling, inactive signs are re-derived by flood
+// fill and the box is renormalized.
 #pragma once
 
 #include "deform/step_deformation.h"

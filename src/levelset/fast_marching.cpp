@@ -32,7 +32,7 @@ class Domain {
   public:
     static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
 
-    Domain(Grid& grid, const openvdb::CoordBBox& region, int margin) : region_(region) {
+    Domain(Grid& grid, const openvdb::CoordBBox& region, int margin) {
         openvdb::CoordBBox outer = region;
         outer.expand(margin);
         for (auto it = grid.tree().beginLeaf(); it; ++it)
@@ -83,7 +83,6 @@ class Domain {
     std::vector<std::uint8_t> active, inRegion;
 
   private:
-    openvdb::CoordBBox region_;
     std::vector<Leaf*> leaves_;
     std::vector<std::array<int, 6>> neighbours_;
 };

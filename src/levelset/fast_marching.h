@@ -2,16 +2,18 @@
 // [Bae01]): after a deformation the values near the surface still locate it, but are no
 // longer distances. Fast marching rebuilds |grad phi| = 1 outward from the surface:
 //
-//  1. seeds: every voxel with a face neighbour of the other sign gets the distance to the
-//     crossings along each axis (linear interpolation of phi), combined as the distance to
-//     the plane through them. The sign of every voxel is kept, so the interface does not
-//     move and features one voxel thin survive.
+//  1. seeds: every voxel with a face neighbour of the other sign gets phi / |grad phi|
+//     (central differences), capped by the distance to its nearest axis crossing. Values
+//     whose gradient is already unit within 1%, and values on or within two voxels of a
+//     feature one voxel thin, are kept: renormalizing twice changes nothing, and thin
+//     features do not drift. The sign of every voxel is kept.
 //  2. march inside and outside in increasing |phi| with the first-order upwind stencil or
 //     the second-order one (HAFMM) where two upwind neighbours are known.
 //  3. voxels past the half-width are deactivated and set to +-background.
 //
-// Only a box of the grid is recomputed; the voxels around it keep their values and act as
-// fixed boundary values.
+// Only a box of the grid is recomputed, on the leaves that overlap it; the voxels around
+// it keep their values and act as fixed boundary values. The band must already lie in
+// leaves (advection activates it before sampling).
 #pragma once
 
 #include "levelset/vdb.h"
