@@ -163,6 +163,7 @@ int runApply(const ApplyArgs& a) {
     options.advect.sampling = a.cubic ? Sampling::MonotoneCubic : Sampling::Trilinear;
     const GridPtr grid = makeStartGrid(script, directoryOf(a.script), options);
     const double before = measureLevelSet(*grid).volume;
+    const TriangleMesh startMesh = a.stats ? meshLevelSet(*grid) : TriangleMesh{};
     const auto reports =
         applyStrokes(*grid, script, options, [&](std::size_t done, std::size_t all) {
             if (!a.quiet)
@@ -171,13 +172,15 @@ int runApply(const ApplyArgs& a) {
         });
     if (!a.quiet && !reports.empty()) std::fprintf(stderr, "\n");
     if (a.stats) {
+        std::fprintf(stderr, "mesh volume before: %.7f\n", enclosedVolume(startMesh));
         std::fprintf(stderr, "stroke segment steps interface widened  grow_ms sample_ms renorm_ms "
-                             "mesh_ms leaves\n");
+                             "mesh_ms leaves mesh_volume\n");
         for (const auto& r : reports)
-            std::fprintf(stderr, "%6zu %7zu %5d %9zu %7.1f %8.1f %9.1f %9.1f %7.1f %6zu\n",
+            std::fprintf(stderr, "%6zu %7zu %5d %9zu %7.1f %8.1f %9.1f %9.1f %7.1f %6zu %11.7f\n",
                          r.stroke, r.segment, r.stats.subSteps, r.stats.interfaceVoxels,
                          r.stats.widenedTo, 1e3 * r.stats.growSeconds, 1e3 * r.stats.sampleSeconds,
-                         1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds, r.remeshedLeaves);
+                         1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds, r.remeshedLeaves,
+                         r.meshVolume);
     }
     double adv = 0, ren = 0, grow = 0;
     for (const auto& r : reports) {

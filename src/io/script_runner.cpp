@@ -96,6 +96,7 @@ std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,
                 r.remeshedLeaves = mesher.update(grid, r.stats.touched);
                 r.meshSeconds =
                     std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+                r.meshVolume = mesher.enclosedVolume();
             }
             reports.push_back(r);
             if (progress) progress(++done, total);

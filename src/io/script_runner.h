@@ -23,6 +23,7 @@ struct SegmentReport {
     double seconds = 0.0;     // advection, renormalization included
     double meshSeconds = 0.0; // incremental re-meshing of the touched leaves (when asked)
     std::size_t remeshedLeaves = 0;
+    double meshVolume = 0.0; // enclosed volume of the mesh after the segment (when remeshing)
 };
 
 // Progress: (segments done, segments in all).

@@ -1,5 +1,6 @@
 #include "mesh/marching_cubes.h"
 
+#include <Eigen/Geometry>
 #include <unordered_map>
 
 #include <tbb/parallel_for.h>
@@ -141,6 +142,18 @@ std::size_t SurfaceMesher::triangleCount() const {
     for (const auto& [o, c] : chunks_)
         n += c.triangles.size();
     return n;
+}
+
+double SurfaceMesher::enclosedVolume() const {
+    double v = 0.0;
+    for (const auto& [o, c] : chunks_)
+        for (const Eigen::Vector3i& t : c.triangles) {
+            const Eigen::Vector3d a = c.positions[t[0]].cast<double>();
+            const Eigen::Vector3d b = c.positions[t[1]].cast<double>();
+            const Eigen::Vector3d d = c.positions[t[2]].cast<double>();
+            v += a.dot(b.cross(d));
+        }
+    return v / 6.0;
 }
 
 TriangleMesh SurfaceMesher::weld() const {

@@ -32,6 +32,9 @@ class SurfaceMesher {
 
     const std::map<openvdb::Coord, MeshChunk>& chunks() const { return chunks_; }
     std::size_t triangleCount() const;
+    // Enclosed volume of the chunks' triangles (divergence theorem; a shared edge vertex has
+    // the same coordinates in both chunks, so no welding is needed).
+    double enclosedVolume() const;
     // One mesh with the chunks welded along their shared edges.
     TriangleMesh weld() const;
 
