@@ -11,6 +11,7 @@
 #include <openvdb/tools/Prune.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 namespace sweepers {
 
@@ -230,68 +231,75 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
     for (std::size_t i = 0; i < n; ++i)
         stats.seeds += state[i] == Known;
 
-    // 2. March from every known or fixed voxel.
+    // 2. March from every known or fixed voxel, inside and outside at once: a voxel's
+    //    update only reads neighbours of its own sign, so the two marches share no data.
     using Item = std::pair<float, std::size_t>;
-    std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
-    auto update = [&](std::size_t i) {
-        const bool neg = negative(b.phi[i]);
-        float m[3], c[3];
-        int k = 0;
-        for (int a = 0; a < 3; ++a) {
-            float best = kInf, second = kInf;
-            for (int dir : {-1, 1}) {
-                const std::size_t j = b.neighbour(i, a, dir);
-                if (j == Domain::npos || state[j] < Known || negative(b.phi[j]) != neg) continue;
-                if (u[j] < best) {
-                    best = u[j];
-                    second = kInf;
-                    if (order == FmmOrder::Second) {
-                        const std::size_t j2 = b.neighbour(j, a, dir);
-                        if (j2 != Domain::npos && state[j2] >= Known &&
-                            negative(b.phi[j2]) == neg && u[j2] <= u[j])
-                            second = u[j2];
+    auto march = [&](const bool side) {
+        std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+        std::size_t marched = 0;
+        auto update = [&](std::size_t i) {
+            float m[3], c[3];
+            int k = 0;
+            for (int a = 0; a < 3; ++a) {
+                float best = kInf, second = kInf;
+                for (int dir : {-1, 1}) {
+                    const std::size_t j = b.neighbour(i, a, dir);
+                    if (j == Domain::npos || negative(b.phi[j]) != side || state[j] < Known)
+                        continue;
+                    if (u[j] < best) {
+                        best = u[j];
+                        second = kInf;
+                        if (order == FmmOrder::Second) {
+                            const std::size_t j2 = b.neighbour(j, a, dir);
+                            if (j2 != Domain::npos && negative(b.phi[j2]) == side &&
+                                state[j2] >= Known && u[j2] <= u[j])
+                                second = u[j2];
+                        }
                     }
                 }
+                if (best == kInf) continue;
+                if (second < kInf) {
+                    m[k] = (4.0f * best - second) / 3.0f; // (3u - 4u1 + u2) / 2h
+                    c[k] = 2.25f;
+                } else {
+                    m[k] = best;
+                    c[k] = 1.0f;
+                }
+                ++k;
             }
-            if (best == kInf) continue;
-            if (second < kInf) {
-                m[k] = (4.0f * best - second) / 3.0f; // (3u - 4u1 + u2) / 2h
-                c[k] = 2.25f;
-            } else {
-                m[k] = best;
-                c[k] = 1.0f;
+            if (k == 0) return;
+            const float v = solveUpwind(m, c, k, h);
+            if (v < u[i]) {
+                u[i] = v;
+                state[i] = Trial;
+                heap.push({v, i});
             }
-            ++k;
+        };
+        auto updateNeighbours = [&](std::size_t i) {
+            for (int a = 0; a < 3; ++a)
+                for (int dir : {-1, 1}) {
+                    const std::size_t j = b.neighbour(i, a, dir);
+                    if (j != Domain::npos && negative(b.phi[j]) == side && state[j] < Known)
+                        update(j);
+                }
+        };
+        for (std::size_t i = 0; i < n; ++i)
+            if (negative(b.phi[i]) == side && state[i] >= Known) updateNeighbours(i);
+        while (!heap.empty()) {
+            const auto [v, i] = heap.top();
+            heap.pop();
+            if (state[i] != Trial || v != u[i]) continue;
+            state[i] = Known;
+            ++marched;
+            if (v > limit) continue; // far enough: leave its neighbours far
+            updateNeighbours(i);
         }
-        if (k == 0) return;
-        const float v = solveUpwind(m, c, k, h);
-        if (v < u[i]) {
-            u[i] = v;
-            state[i] = Trial;
-            heap.push({v, i});
-        }
+        return marched;
     };
-    for (std::size_t i = 0; i < n; ++i) {
-        if (state[i] < Known) continue;
-        for (int a = 0; a < 3; ++a)
-            for (int dir : {-1, 1}) {
-                const std::size_t j = b.neighbour(i, a, dir);
-                if (j != Domain::npos && state[j] < Known) update(j);
-            }
-    }
-    while (!heap.empty()) {
-        const auto [v, i] = heap.top();
-        heap.pop();
-        if (state[i] != Trial || v != u[i]) continue;
-        state[i] = Known;
-        ++stats.marched;
-        if (v > limit) continue; // far enough: leave its neighbours far
-        for (int a = 0; a < 3; ++a)
-            for (int dir : {-1, 1}) {
-                const std::size_t j = b.neighbour(i, a, dir);
-                if (j != Domain::npos && state[j] < Known) update(j);
-            }
-    }
+    std::size_t marchedOutside = 0, marchedInside = 0;
+    tbb::parallel_invoke([&] { marchedOutside = march(false); },
+                         [&] { marchedInside = march(true); });
+    stats.marched = marchedOutside + marchedInside;
 
     // 3. Write back: inside the band active with the new distance, beyond it off. Every
     //    voxel lives in an existing leaf, so leaves are written in parallel.

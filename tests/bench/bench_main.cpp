@@ -236,8 +236,8 @@ int main(int argc, char** argv) {
         const Name n = split(r.benchmark_name());
         timeOf[n.group + "/" + n.item + "/" + n.method] = r.GetAdjustedRealTime();
     }
-    std::printf("\n%-8s %-22s %-32s %12s %12s %9s\n", "group", "case", "method", "ms", "openvdb ms",
-                "speed-up");
+    std::printf("\n%-8s %-22s %-32s %12s %12s %9s\n", "group", "case", "method", "ms",
+                "reference ms", "speed-up");
     std::map<std::string, double> speedUp;
     for (const auto& r : collector.runs()) {
         const Name n = split(r.benchmark_name());
