@@ -60,6 +60,14 @@ std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& b
 
 } // namespace
 
+openvdb::CoordBBox changedRegion(const Grid& grid, const StepDeformation& seg) {
+    // The sampled region, and the band activated around images of the interface (which
+    // stay inside the affected box: the deformation maps it onto itself).
+    openvdb::CoordBBox box = indexBox(grid, seg.affectedBox(), 1);
+    box.expand(int(std::ceil(halfWidthOf(grid))) + 1);
+    return box;
+}
+
 openvdb::CoordBBox indexBox(const Grid& grid, const Box& world, int pad) {
     if (world.empty()) return {};
     const openvdb::Vec3d lo = grid.worldToIndex(toVdb(world.min));
@@ -183,8 +191,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
 
     // 3. Renormalize the changed region (and the band around it).
     t0 = Clock::now();
-    openvdb::CoordBBox touched = region;
-    touched.expand(dilation);
+    const openvdb::CoordBBox touched = changedRegion(grid, seg);
     if (options.renormalize) renormalize(grid, touched, options.renormalization);
     stats.renormalizeSeconds = since(t0);
     stats.touched = touched;

@@ -44,6 +44,9 @@ struct AdvectStats {
 AdvectStats advectSegment(Grid& grid, const StepDeformation& segment,
                           const AdvectOptions& options = {});
 
+// The index box whose voxels advectSegment(grid, segment) may change (what undo saves).
+openvdb::CoordBBox changedRegion(const Grid& grid, const StepDeformation& segment);
+
 // The index box of a world box, grown by `pad` voxels.
 openvdb::CoordBBox indexBox(const Grid& grid, const Box& world, int pad);
 

@@ -254,6 +254,7 @@ int main(int argc, char** argv) {
     // Every figure, appended to the CSV with the commit and the machine.
     const bool fresh = !std::ifstream(csvPath).good();
     std::ofstream csv(csvPath, std::ios::app);
+    csv.precision(10);
     if (!csv) {
         std::fprintf(stderr, "sweepers-bench: cannot write %s\n", csvPath.c_str());
         return 1;

@@ -1,0 +1,75 @@
+// The modeler's document: a level set, its mesh kept up to date leaf by leaf, every edit
+// recorded as a stroke script (which `sweepers-cli apply` replays to the same grid), and
+// undo / redo that keep only the blocks a stroke touched. No GL here.
+#pragma once
+
+#include <deque>
+#include <string>
+
+#include "io/script_runner.h"
+#include "io/stroke_script.h"
+#include "levelset/leaf_snapshot.h"
+#include "mesh/marching_cubes.h"
+
+namespace sweepers {
+
+class Document {
+  public:
+    // Builds the script's start shape and applies its strokes (they become the document's
+    // history, not undoable). Throws on bad input, leaving nothing half made.
+    Document(StrokeScript script, const std::string& scriptDir);
+    // A unit sphere at voxel size h.
+    static StrokeScript sphereScript(double voxelSize);
+    // Opens a .vdb (a float level set) or a .json stroke script.
+    static Document open(const std::string& path);
+
+    const Grid& grid() const { return *grid_; }
+    const SurfaceMesher& mesher() const { return mesher_; }
+    const StrokeScript& script() const { return script_; }
+    const std::string& scriptDir() const { return scriptDir_; }
+
+    // Sculpting: a sweep of one tool whose path grows by one placement per drag event;
+    // each new placement is advected at once as one segment.
+    void beginStroke(const ToolSpec& tool, MirrorAxis mirror);
+    bool inStroke() const { return inStroke_; }
+    SegmentReport extendStroke(const Placement& next);
+    void endStroke();
+
+    bool canUndo() const { return !undo_.empty(); }
+    bool canRedo() const { return !redo_.empty(); }
+    void undo();
+    void redo();
+    std::size_t undoBytes() const;
+    std::size_t undoBudget() const { return budget_; }
+    void setUndoBudget(std::size_t bytes);
+    std::size_t undoCount() const { return undo_.size(); }
+
+    // Modified since opened or last saved (the grid or the script).
+    bool modified() const { return modified_; }
+    void saveVdb(const std::string& path);
+    void saveScript(const std::string& path);
+    void markSaved() { modified_ = false; }
+
+    // Leaves whose mesh changed since the last call (for re-upload).
+    bool takeMeshChanged();
+
+  private:
+    struct Edit {
+        Stroke stroke;
+        LeafSnapshot snapshot; // undo stack: before the stroke; redo stack: after it
+    };
+    void trimToBudget();
+
+    StrokeScript script_;
+    std::string scriptDir_;
+    GridPtr grid_;
+    SurfaceMesher mesher_;
+    std::deque<Edit> undo_;
+    std::vector<Edit> redo_;
+    std::size_t budget_ = std::size_t(512) << 20;
+    bool inStroke_ = false, modified_ = false, meshChanged_ = true;
+    SweepStroke current_;
+    LeafSnapshot before_;
+};
+
+} // namespace sweepers

@@ -1,0 +1,119 @@
+// The modeler's document without a window: strokes, undo / redo, the recorded script,
+// and picking the surface.
+#include <gtest/gtest.h>
+
+#include "app/document.h"
+#include "levelset/raycast.h"
+
+using namespace sweepers;
+
+namespace {
+
+// Every voxel of the union of both grids' active boxes: same value, same state.
+std::size_t differingVoxels(const Grid& a, const Grid& b) {
+    openvdb::CoordBBox box = a.evalActiveVoxelBoundingBox();
+    box.expand(b.evalActiveVoxelBoundingBox());
+    box.expand(8);
+    auto ca = a.getConstAccessor();
+    auto cb = b.getConstAccessor();
+    std::size_t n = 0;
+    for (auto it = box.begin(); it; ++it)
+        n += ca.getValue(*it) != cb.getValue(*it) || ca.isValueOn(*it) != cb.isValueOn(*it);
+    return n;
+}
+
+ToolSpec ballAt(const Eigen::Vector3d& p) {
+    ToolSpec t;
+    t.size = Eigen::Vector3d::Constant(0.25);
+    t.falloff = 0.3;
+    Placement pl;
+    pl.t = p;
+    t.path = {pl};
+    return t;
+}
+
+// A drag of `n` segments from p along d.
+void drag(Document& doc, const Eigen::Vector3d& p, const Eigen::Vector3d& d, int n) {
+    doc.beginStroke(ballAt(p), MirrorAxis::None);
+    for (int i = 1; i <= n; ++i) {
+        Placement pl;
+        pl.t = p + d * (double(i) / n);
+        doc.extendStroke(pl);
+    }
+    doc.endStroke();
+}
+
+} // namespace
+
+TEST(Document, UndoRestoresTheGridExactlyAndRedoReappliesIt) {
+    Document doc(Document::sphereScript(1.0 / 32), ".");
+    const GridPtr start = doc.grid().deepCopy();
+    drag(doc, {0, 0, 1}, {0, 0, 0.4}, 4);
+    const GridPtr one = doc.grid().deepCopy();
+    drag(doc, {1, 0, 0}, {0.3, 0.2, 0}, 3);
+    drag(doc, {0, -1, 0}, {0, 0.5, 0}, 5); // pushes in
+    const GridPtr three = doc.grid().deepCopy();
+    ASSERT_GT(differingVoxels(*start, *three), 1000u); // the strokes did something
+    EXPECT_EQ(doc.undoCount(), 3u);
+    EXPECT_EQ(doc.script().strokes.size(), 3u);
+
+    doc.undo();
+    doc.undo();
+    EXPECT_EQ(differingVoxels(doc.grid(), *one), 0u);
+    EXPECT_EQ(doc.script().strokes.size(), 1u);
+    doc.undo();
+    EXPECT_EQ(differingVoxels(doc.grid(), *start), 0u);
+    EXPECT_FALSE(doc.canUndo());
+
+    doc.redo();
+    EXPECT_EQ(differingVoxels(doc.grid(), *one), 0u);
+    doc.redo();
+    doc.redo();
+    EXPECT_EQ(differingVoxels(doc.grid(), *three), 0u);
+    EXPECT_EQ(doc.script().strokes.size(), 3u);
+    EXPECT_FALSE(doc.canRedo());
+
+    // The incrementally kept mesh is the mesh of the restored grid.
+    doc.undo();
+    SurfaceMesher fresh;
+    fresh.rebuild(doc.grid());
+    EXPECT_EQ(doc.mesher().triangleCount(), fresh.triangleCount());
+    EXPECT_NEAR(doc.mesher().enclosedVolume(), fresh.enclosedVolume(), 1e-9);
+}
+
+TEST(Document, UndoKeepsWithinItsBudget) {
+    Document doc(Document::sphereScript(1.0 / 32), ".");
+    drag(doc, {0, 0, 1}, {0, 0, 0.3}, 3);
+    const std::size_t oneStroke = doc.undoBytes();
+    ASSERT_GT(oneStroke, 0u);
+    doc.setUndoBudget(oneStroke * 2 + oneStroke / 2);
+    for (int i = 0; i < 4; ++i)
+        drag(doc, {std::cos(i * 1.5), std::sin(i * 1.5), 0}, {0, 0, 0.2}, 2);
+    EXPECT_LE(doc.undoBytes(), doc.undoBudget());
+    EXPECT_GE(doc.undoCount(), 1u);
+    EXPECT_LT(doc.undoCount(), 5u);
+    EXPECT_EQ(doc.script().strokes.size(), 5u); // the history is all in the script
+}
+
+TEST(Document, RecordedScriptReplaysToTheSameGrid) {
+    Document doc(Document::sphereScript(1.0 / 32), ".");
+    drag(doc, {0, 0, 1}, {0.2, 0, 0.4}, 6);
+    drag(doc, {0.7, 0.7, 0}, {-0.2, -0.2, 0.1}, 3);
+    doc.undo(); // an undone stroke is not in the script
+    drag(doc, {0, 1, 0}, {0, 0.3, 0.1}, 2);
+    const StrokeScript replayed = parseStrokeScript(formatStrokeScript(doc.script()), "recorded");
+    RunOptions options;
+    GridPtr g = makeStartGrid(replayed, ".", options);
+    applyStrokes(*g, replayed, options);
+    EXPECT_EQ(differingVoxels(*g, doc.grid()), 0u);
+}
+
+TEST(Raycast, HitsTheSphereWhereTheRayEntersIt) {
+    Document doc(Document::sphereScript(1.0 / 32), ".");
+    const auto hit = raycastLevelSet(doc.grid(), {0.3, 0.2, 5}, {0, 0, -1}, 100);
+    ASSERT_TRUE(hit);
+    EXPECT_NEAR(hit->norm(), 1.0, 0.01);
+    EXPECT_GT(hit->z(), 0.0);
+    EXPECT_FALSE(raycastLevelSet(doc.grid(), {3, 0, 5}, {0, 0, -1}, 100));
+    EXPECT_FALSE(raycastLevelSet(doc.grid(), {0, 0, 5}, {0, 0, 1}, 100)); // facing away
+}
