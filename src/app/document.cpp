@@ -70,7 +70,7 @@ SegmentReport Document::extendStroke(const Placement& next) {
     r.remeshedLeaves = mesher_.update(*grid_, r.stats.touched);
     r.meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     current_ = std::move(trial);
-    modified_ = meshChanged_ = true;
+    modified_ = true;
     return r;
 }
 
@@ -95,7 +95,7 @@ void Document::undo() {
     mesher_.update(*grid_, e.snapshot.bounds());
     script_.strokes.pop_back();
     redo_.push_back({std::move(e.stroke), std::move(after)});
-    modified_ = meshChanged_ = true;
+    modified_ = true;
 }
 
 void Document::redo() {
@@ -108,7 +108,7 @@ void Document::redo() {
     mesher_.update(*grid_, e.snapshot.bounds());
     script_.strokes.push_back(e.stroke);
     undo_.push_back({std::move(e.stroke), std::move(before)});
-    modified_ = meshChanged_ = true;
+    modified_ = true;
     trimToBudget();
 }
 
@@ -138,12 +138,6 @@ void Document::saveVdb(const std::string& path) {
 
 void Document::saveScript(const std::string& path) {
     writeStrokeScript(script_, path);
-}
-
-bool Document::takeMeshChanged() {
-    const bool c = meshChanged_;
-    meshChanged_ = false;
-    return c;
 }
 
 } // namespace sweepers

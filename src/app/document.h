@@ -50,8 +50,8 @@ class Document {
     void saveScript(const std::string& path);
     void markSaved() { modified_ = false; }
 
-    // Leaves whose mesh changed since the last call (for re-upload).
-    bool takeMeshChanged();
+    // What changed in the mesh since the last call (for re-upload).
+    MeshChanges takeMeshChanges() { return mesher_.takeChanges(); }
 
   private:
     struct Edit {
@@ -67,7 +67,7 @@ class Document {
     std::deque<Edit> undo_;
     std::vector<Edit> redo_;
     std::size_t budget_ = std::size_t(512) << 20;
-    bool inStroke_ = false, modified_ = false, meshChanged_ = true;
+    bool inStroke_ = false, modified_ = false;
     SweepStroke current_;
     LeafSnapshot before_;
 };

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <unordered_map>
+#include <utility>
 
 #include <tbb/parallel_for.h>
 
@@ -113,7 +114,12 @@ void SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coor
     }
 }
 
+MeshChanges SurfaceMesher::takeChanges() {
+    return std::exchange(changes_, MeshChanges{});
+}
+
 void SurfaceMesher::rebuild(const Grid& grid) {
+    changes_.all = true;
     chunks_.clear();
     std::vector<openvdb::Coord> origins;
     for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
@@ -124,6 +130,7 @@ void SurfaceMesher::rebuild(const Grid& grid) {
 std::size_t SurfaceMesher::update(const Grid& grid, const openvdb::CoordBBox& touched) {
     openvdb::CoordBBox box = touched;
     box.expand(1);
+    changes_.box.expand(box);
     // Forget every chunk whose leaf overlaps the box, then mesh the leaves there now.
     for (auto it = chunks_.begin(); it != chunks_.end();) {
         const openvdb::CoordBBox leafBox =

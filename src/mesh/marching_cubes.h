@@ -23,6 +23,14 @@ struct MeshChunk {
     std::vector<Eigen::Vector3i> triangles;
 };
 
+// What changed in a mesher since it was last asked: everything, or the chunks whose
+// leaves overlap a box.
+struct MeshChanges {
+    bool all = false;
+    openvdb::CoordBBox box; // index space; empty when nothing changed
+    bool any() const { return all || !box.empty(); }
+};
+
 class SurfaceMesher {
   public:
     // Meshes every active leaf.
@@ -31,6 +39,8 @@ class SurfaceMesher {
     std::size_t update(const Grid& grid, const openvdb::CoordBBox& touched);
 
     const std::map<openvdb::Coord, MeshChunk>& chunks() const { return chunks_; }
+    // The changes since the last call (a renderer re-uploads only those).
+    MeshChanges takeChanges();
     std::size_t triangleCount() const;
     // Enclosed volume of the chunks' triangles (divergence theorem; a shared edge vertex has
     // the same coordinates in both chunks, so no welding is needed).
@@ -41,6 +51,7 @@ class SurfaceMesher {
   private:
     void meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins);
     std::map<openvdb::Coord, MeshChunk> chunks_;
+    MeshChanges changes_{true, {}};
 };
 
 // Convenience: the welded mesh of a whole grid.

@@ -1,0 +1,56 @@
+// Draws a document with OpenGL 3.3 core: the clay surface in bricks of 4^3 leaves (only
+// bricks whose chunks changed are re-uploaded), an optional wireframe, the ground grid,
+// and the tool with its coating as translucent shells.
+#pragma once
+
+#include <map>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "mesh/marching_cubes.h"
+
+namespace sweepers {
+
+struct ToolOverlay {
+    bool visible = false;
+    glm::dvec3 center{0.0};
+    double radius = 0.25, falloff = 0.25;
+};
+
+class GlRenderer {
+  public:
+    // Compiles the shaders found in `shaderDir`; throws with the compiler's log on failure.
+    explicit GlRenderer(const std::string& shaderDir);
+    ~GlRenderer();
+    GlRenderer(const GlRenderer&) = delete;
+    GlRenderer& operator=(const GlRenderer&) = delete;
+
+    // Re-uploads what changed.
+    void update(const SurfaceMesher& mesher, const MeshChanges& changes);
+    void draw(const glm::dmat4& view, const glm::dmat4& projection, bool wireframe,
+              const ToolOverlay& tool, double groundY);
+
+    std::size_t bricks() const { return bricks_.size(); }
+    std::size_t uploadedBricksLastUpdate() const { return lastUploads_; }
+
+  private:
+    struct GpuMesh {
+        unsigned vao = 0, vbo = 0, ebo = 0;
+        int indexCount = 0;
+    };
+    void uploadBrick(const SurfaceMesher& mesher, const openvdb::Coord& brick);
+    void releaseBrick(GpuMesh& m);
+
+    unsigned clay_ = 0, flat_ = 0;
+    std::map<openvdb::Coord, GpuMesh> bricks_;
+    GpuMesh sphere_, grid_;
+    int gridLines_ = 0;
+    std::size_t lastUploads_ = 0;
+};
+
+// Where the shaders are: next to the binary (shaders/ or ../share/sweepers/shaders), else
+// the source tree's shaders/.
+std::string findShaderDir(const std::string& argv0);
+
+} // namespace sweepers

@@ -1,0 +1,84 @@
+#include "app/input_replay.h"
+
+#include <cctype>
+#include <cmath>
+#include <fstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+namespace sweepers {
+
+std::vector<InputEvent> readInputEvents(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error(path + ": cannot open");
+    nlohmann::json doc;
+    try {
+        doc = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& e) {
+        throw std::runtime_error(path + ": " + e.what());
+    }
+    if (!doc.is_object() || !doc.contains("events") || !doc["events"].is_array())
+        throw std::runtime_error(path + ": expected {\"events\": [...]}");
+    std::vector<InputEvent> out;
+    int lastFrame = 0;
+    for (std::size_t i = 0; i < doc["events"].size(); ++i) {
+        const auto& e = doc["events"][i];
+        const std::string where = path + ": /events/" + std::to_string(i) + ": ";
+        try {
+            InputEvent ev;
+            ev.frame = e.at("frame").get<int>();
+            if (ev.frame < lastFrame) throw std::runtime_error("frames must not go back");
+            lastFrame = ev.frame;
+            const std::string type = e.at("type").get<std::string>();
+            auto number = [&](const char* k) {
+                const double v = e.at(k).get<double>();
+                if (!std::isfinite(v)) throw std::runtime_error(std::string(k) + " is not finite");
+                return v;
+            };
+            if (type == "press" || type == "release") {
+                ev.type = type == "press" ? InputEvent::Type::Press : InputEvent::Type::Release;
+                const std::string b = e.value("button", "left");
+                if (b == "left")
+                    ev.button = 0;
+                else if (b == "right")
+                    ev.button = 1;
+                else if (b == "middle")
+                    ev.button = 2;
+                else
+                    throw std::runtime_error("unknown button \"" + b + "\"");
+                ev.x = number("x");
+                ev.y = number("y");
+            } else if (type == "move") {
+                ev.type = InputEvent::Type::Move;
+                ev.x = number("x");
+                ev.y = number("y");
+            } else if (type == "key") {
+                ev.type = InputEvent::Type::Key;
+                const std::string k = e.at("key").get<std::string>();
+                if (k.size() != 1 || !std::isalnum(static_cast<unsigned char>(k[0])))
+                    throw std::runtime_error("key must be one letter or digit");
+                ev.key = std::toupper(static_cast<unsigned char>(k[0]));
+                ev.ctrl = e.value("ctrl", false);
+                ev.shift = e.value("shift", false);
+            } else if (type == "scroll") {
+                ev.type = InputEvent::Type::Scroll;
+                ev.dy = number("dy");
+                ev.ctrl = e.value("ctrl", false); // ctrl + wheel: tool radius
+            } else if (type == "drop") {
+                ev.type = InputEvent::Type::Drop;
+                ev.path = e.at("path").get<std::string>();
+            } else {
+                throw std::runtime_error("unknown type \"" + type + "\"");
+            }
+            out.push_back(ev);
+        } catch (const nlohmann::json::exception& x) {
+            throw std::runtime_error(where + x.what());
+        } catch (const std::runtime_error& x) {
+            throw std::runtime_error(where + x.what());
+        }
+    }
+    return out;
+}
+
+} // namespace sweepers

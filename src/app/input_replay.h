@@ -1,0 +1,36 @@
+// Recorded mouse and keyboard events, replayed frame by frame into the real window's
+// handlers, so tests drive the modeler exactly as a user would.
+//
+//   { "events": [
+//       { "frame": 3, "type": "press",   "button": "left", "x": 400, "y": 300 },
+//       { "frame": 4, "type": "move",    "x": 420, "y": 290 },
+//       { "frame": 5, "type": "release", "button": "left", "x": 420, "y": 290 },
+//       { "frame": 7, "type": "key",     "key": "z", "ctrl": true, "shift": false },
+//       { "frame": 8, "type": "scroll",  "dy": -1 },
+//       { "frame": 9, "type": "drop",    "path": "shape.vdb" } ] }   (a file dropped on it)
+//
+// Coordinates are window pixels (origin top left); frames count from 0; events of one
+// frame are delivered in file order before that frame is drawn.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace sweepers {
+
+struct InputEvent {
+    enum class Type { Press, Release, Move, Key, Scroll, Drop };
+    int frame = 0;
+    Type type = Type::Move;
+    int button = 0; // 0 left, 1 right, 2 middle
+    double x = 0, y = 0, dy = 0;
+    int key = 0; // an uppercase ASCII letter or digit, or a GLFW key code for others
+    bool ctrl = false, shift = false;
+    std::string path; // Drop
+};
+
+// Reads and checks a replay file; throws std::runtime_error naming the file, the event
+// and the problem.
+std::vector<InputEvent> readInputEvents(const std::string& path);
+
+} // namespace sweepers

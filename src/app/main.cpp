@@ -1,0 +1,56 @@
+// sweepers: the interactive modeler.
+#include <cstdio>
+#include <stdexcept>
+
+#include <CLI/CLI.hpp>
+#include <tbb/global_control.h>
+
+#include "app/modeler.h"
+#include "io/stroke_script.h"
+
+int main(int argc, char** argv) {
+    sweepers::ModelerOptions o;
+    o.argv0 = argv[0];
+    std::string script, size;
+    int threads = 0;
+    CLI::App app{"Sweepers: sculpt a level set with swept space deformations"};
+    app.add_option("file", o.open, "a .vdb level set or a stroke script (.json) to open");
+    app.add_option("--script", script, "a stroke script to open (same as giving it as file)");
+    app.add_option("--voxel-size", o.voxelSize, "voxel size of a new sphere")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--size", size, "window size WIDTHxHEIGHT (default 1280x800)");
+    app.add_option("--screenshot", o.screenshot, "render one frame to this PNG and exit");
+    app.add_option("--replay-input", o.replayInput,
+                   "replay recorded mouse and keyboard events (JSON), then exit");
+    app.add_option("--save", o.saveVdb, "write the level set here when the window closes");
+    app.add_option("--save-script", o.saveScript,
+                   "write the recorded stroke script here when the window closes");
+    app.add_flag("--hide-ui", o.hideUi, "draw no panels");
+    app.add_option("--threads", threads, "worker threads (default: all cores)")
+        ->check(CLI::Range(1, 1024));
+    CLI11_PARSE(app, argc, argv);
+    try {
+        if (!script.empty()) {
+            if (!o.open.empty()) throw std::runtime_error("give either a file or --script");
+            o.open = script;
+        }
+        if (!size.empty()) {
+            int w = 0, h = 0;
+            char x = 0, extra = 0;
+            if (std::sscanf(size.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' ||
+                w < 64 || h < 64 || w > 8192 || h > 8192)
+                throw std::runtime_error(
+                    "--size wants WIDTHxHEIGHT between 64 and 8192, like 800x600");
+            o.width = w;
+            o.height = h;
+        }
+        std::unique_ptr<tbb::global_control> limit;
+        if (threads > 0)
+            limit = std::make_unique<tbb::global_control>(
+                tbb::global_control::max_allowed_parallelism, threads);
+        return sweepers::runModeler(o);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "sweepers: %s\n", e.what());
+        return 1;
+    }
+}

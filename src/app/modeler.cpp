@@ -1,0 +1,561 @@
+#define GL_GLEXT_PROTOTYPES
+#include "app/modeler.h"
+
+#include <GL/gl.h>
+#include <GLFW/glfw3.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+
+#include <backends/imgui_impl_glfw.h>
+#include <backends/imgui_impl_opengl3.h>
+#include <imgui.h>
+#include <stb_image_write.h>
+
+#include "app/camera.h"
+#include "app/document.h"
+#include "app/gl_renderer.h"
+#include "app/input_replay.h"
+#include "io/mesh_file.h"
+#include "levelset/level_set.h"
+#include "levelset/raycast.h"
+
+namespace sweepers {
+
+namespace {
+
+enum class Mode { Grab, Twist, Inflate };
+enum class Drag { None, Sculpt, Orbit, Pan };
+
+glm::dvec3 toGlm(const Eigen::Vector3d& v) {
+    return {v.x(), v.y(), v.z()};
+}
+Eigen::Vector3d toEigen3(const glm::dvec3& v) {
+    return {v.x, v.y, v.z};
+}
+
+class Modeler {
+  public:
+    Modeler(const ModelerOptions& o, GLFWwindow* w) : opt_(o), win_(w) {
+        doc_ = std::make_unique<Document>(o.open.empty()
+                                              ? Document(Document::sphereScript(o.voxelSize), ".")
+                                              : Document::open(o.open));
+        renderer_ = std::make_unique<GlRenderer>(findShaderDir(o.argv0));
+        frame();
+        std::snprintf(path_, sizeof path_, "%s", o.open.empty() ? "untitled.vdb" : o.open.c_str());
+    }
+
+    int run() {
+        std::vector<InputEvent> events;
+        if (!opt_.replayInput.empty()) events = readInputEvents(opt_.replayInput);
+        const bool batch = !opt_.replayInput.empty() || !opt_.screenshot.empty();
+        const int lastFrame = events.empty() ? 1 : events.back().frame + 2;
+        std::size_t next = 0;
+        for (int f = 0; !glfwWindowShouldClose(win_); ++f) {
+            const auto t0 = std::chrono::steady_clock::now();
+            glfwPollEvents();
+            for (; next < events.size() && events[next].frame == f; ++next)
+                dispatch(events[next]);
+            step();
+            draw();
+            if (batch && f >= lastFrame) {
+                if (!opt_.screenshot.empty()) screenshot(opt_.screenshot);
+                glfwSetWindowShouldClose(win_, GLFW_TRUE);
+            }
+            glfwSwapBuffers(win_);
+            frameMs_ =
+                1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            if (!batch && glfwWindowShouldClose(win_) && doc_->modified() && !discard_) {
+                glfwSetWindowShouldClose(win_, GLFW_FALSE); // ask first
+                askQuit_ = true;
+            }
+        }
+        doc_->endStroke();
+        if (!opt_.saveVdb.empty()) doc_->saveVdb(opt_.saveVdb);
+        if (!opt_.saveScript.empty()) doc_->saveScript(opt_.saveScript);
+        return 0;
+    }
+
+    // --- input, from GLFW callbacks or a replay -------------------------------------
+    void onButton(int button, bool press, double x, double y, bool shift) {
+        cursorX_ = x;
+        cursorY_ = y;
+        if (!press) {
+            if (drag_ == Drag::Sculpt) {
+                step(); // the last position counts
+                doc_->endStroke();
+                volume_ = doc_->mesher().enclosedVolume();
+            }
+            drag_ = Drag::None;
+            return;
+        }
+        pressX_ = lastX_ = x;
+        pressY_ = lastY_ = y;
+        if (button == 1 || button == 2 || (button == 0 && shift)) {
+            drag_ = Drag::Pan;
+            return;
+        }
+        const auto hit = pick(x, y);
+        if (!hit) {
+            drag_ = Drag::Orbit;
+            return;
+        }
+        grab_ = *hit;
+        axis_ = glm::normalize(camera_.eye() - camera_.target);
+        ToolSpec tool;
+        tool.shape = "ball";
+        tool.size = Eigen::Vector3d::Constant(radius_);
+        tool.falloff = falloff_;
+        tool.path = {placementAt(x, y)};
+        doc_->beginStroke(tool, mirror_);
+        drag_ = Drag::Sculpt;
+        pending_ = false;
+    }
+
+    void onMove(double x, double y) {
+        const double dx = x - lastX_, dy = y - lastY_;
+        cursorX_ = x;
+        cursorY_ = y;
+        int w, h;
+        glfwGetWindowSize(win_, &w, &h);
+        switch (drag_) {
+        case Drag::Orbit:
+            camera_.orbit(-dx * 0.008, dy * 0.008);
+            break;
+        case Drag::Pan:
+            camera_.pan(dx / h, dy / h);
+            break;
+        case Drag::Sculpt:
+            pending_ = true; // coalesced: one segment per frame, at the latest position
+            break;
+        case Drag::None:
+            break;
+        }
+        lastX_ = x;
+        lastY_ = y;
+    }
+
+    void onScroll(double dy, bool ctrl) {
+        if (ctrl)
+            radius_ = std::clamp(radius_ * std::pow(1.1, dy), 0.02, 2.0);
+        else
+            camera_.zoom(std::pow(0.9, dy));
+    }
+
+    void onKey(int key, bool ctrl, bool shift) {
+        if (ctrl && key == 'Z') {
+            shift ? doc_->redo() : doc_->undo();
+            volume_ = doc_->mesher().enclosedVolume();
+        } else if (ctrl && key == 'S') {
+            save(path_);
+        } else if (!ctrl) {
+            switch (key) {
+            case 'G':
+                mode_ = Mode::Grab;
+                break;
+            case 'T':
+                mode_ = Mode::Twist;
+                break;
+            case 'I':
+                mode_ = Mode::Inflate;
+                break;
+            case 'F':
+                frame();
+                break;
+            case 'W':
+                wireframe_ = !wireframe_;
+                break;
+            case 'M':
+                mirror_ = MirrorAxis((int(mirror_) + 1) % 4);
+                break;
+            case '[':
+                radius_ = std::max(0.02, radius_ / 1.1);
+                break;
+            case ']':
+                radius_ = std::min(2.0, radius_ * 1.1);
+                break;
+            case GLFW_KEY_LEFT:
+                camera_.orbit(-0.1, 0);
+                break;
+            case GLFW_KEY_RIGHT:
+                camera_.orbit(0.1, 0);
+                break;
+            case GLFW_KEY_UP:
+                camera_.orbit(0, 0.1);
+                break;
+            case GLFW_KEY_DOWN:
+                camera_.orbit(0, -0.1);
+                break;
+            case GLFW_KEY_EQUAL:
+                camera_.zoom(0.9);
+                break;
+            case GLFW_KEY_MINUS:
+                camera_.zoom(1.0 / 0.9);
+                break;
+            default:
+                break;
+            }
+        }
+    }
+
+    // Opens a file (dropped on the window, or the Open button); a file that cannot be
+    // opened leaves the current document as it was.
+    void openFile(const std::string& path) {
+        try {
+            auto d = std::make_unique<Document>(Document::open(path));
+            doc_ = std::move(d);
+            renderer_->update(doc_->mesher(), MeshChanges{true, {}});
+            frame();
+            std::snprintf(path_, sizeof path_, "%s", path.c_str());
+            status_ = "opened " + path;
+        } catch (const std::exception& e) {
+            fail(e.what());
+        }
+    }
+
+  private:
+    // Errors go to a dialog, and to stderr for whoever started the modeler.
+    void fail(const std::string& message) {
+        error_ = message;
+        std::fprintf(stderr, "sweepers: %s\n", message.c_str());
+    }
+
+    void dispatch(const InputEvent& e) {
+        switch (e.type) {
+        case InputEvent::Type::Press:
+        case InputEvent::Type::Release:
+            onMove(e.x, e.y);
+            onButton(e.button, e.type == InputEvent::Type::Press, e.x, e.y, e.shift);
+            break;
+        case InputEvent::Type::Move:
+            onMove(e.x, e.y);
+            break;
+        case InputEvent::Type::Key:
+            onKey(e.key, e.ctrl, e.shift);
+            break;
+        case InputEvent::Type::Scroll:
+            onScroll(e.dy, e.ctrl);
+            break;
+        case InputEvent::Type::Drop:
+            openFile(e.path);
+            break;
+        }
+    }
+
+    std::optional<glm::dvec3> pick(double x, double y) const {
+        int w, h;
+        glfwGetWindowSize(win_, &w, &h);
+        const Ray r = camera_.rayThrough(x, y, w, h);
+        const auto hit = raycastLevelSet(doc_->grid(), toEigen3(r.origin), toEigen3(r.direction),
+                                         1e3 * camera_.distance);
+        if (!hit) return std::nullopt;
+        return toGlm(*hit);
+    }
+
+    // The tool placement for the cursor at (x, y) during a drag, by mode.
+    Placement placementAt(double x, double y) const {
+        int w, h;
+        glfwGetWindowSize(win_, &w, &h);
+        Placement p;
+        p.t = toEigen3(grab_);
+        switch (mode_) {
+        case Mode::Grab:
+            p.t = toEigen3(grab_ + camera_.dragInViewPlane(grab_, pressX_, pressY_, x, y, w, h));
+            break;
+        case Mode::Twist:
+            p.axis = toEigen3(axis_);
+            p.angleDegrees = std::clamp(0.5 * (x - pressX_), -720.0, 720.0);
+            break;
+        case Mode::Inflate:
+            p.scale = Eigen::Vector3d::Constant(
+                std::exp(std::clamp(-(y - pressY_), -400.0, 400.0) * 0.004));
+            break;
+        }
+        return p;
+    }
+
+    // One sweep segment per frame for the latest cursor position of a drag.
+    void step() {
+        if (drag_ != Drag::Sculpt || !pending_) return;
+        pending_ = false;
+        const Placement p = placementAt(cursorX_, cursorY_);
+        if (p == last_) return;
+        try {
+            last_ = p;
+            report_ = doc_->extendStroke(p);
+            segments_++;
+        } catch (const std::exception& e) {
+            doc_->endStroke();
+            drag_ = Drag::None;
+            fail(e.what());
+        }
+    }
+
+    void frame() {
+        const Box b = activeWorldBox(doc_->grid());
+        camera_.frame(toGlm(b.min), toGlm(b.max));
+        volume_ = doc_->mesher().enclosedVolume();
+    }
+
+    void save(const std::string& path) {
+        try {
+            if (path.size() > 5 && path.substr(path.size() - 5) == ".json") {
+                doc_->saveScript(path);
+            } else if (isMeshPath(path)) {
+                writeMesh(doc_->mesher().weld(), path);
+                return; // an export does not save the document
+            } else {
+                doc_->saveVdb(path);
+            }
+            doc_->markSaved();
+            status_ = "saved " + path;
+        } catch (const std::exception& e) {
+            fail(e.what());
+        }
+    }
+
+    void draw() {
+        int fw, fh;
+        glfwGetFramebufferSize(win_, &fw, &fh);
+        glViewport(0, 0, fw, fh);
+        glClearColor(0.16f, 0.17f, 0.19f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        const auto t0 = std::chrono::steady_clock::now();
+        renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
+        uploadMs_ =
+            1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        ToolOverlay tool;
+        tool.radius = radius_;
+        tool.falloff = falloff_;
+        if (drag_ == Drag::Sculpt) {
+            tool.visible = true;
+            tool.center = toGlm(last_.t);
+        } else if (drag_ == Drag::None) {
+            if (const auto hit = pick(cursorX_, cursorY_)) {
+                tool.visible = true;
+                tool.center = *hit;
+            }
+        }
+        const Box b = activeWorldBox(doc_->grid());
+        renderer_->draw(camera_.view(), camera_.projection(double(fw) / std::max(fh, 1)),
+                        wireframe_, tool, b.min.y());
+        if (!opt_.hideUi) panels();
+    }
+
+    void panels() {
+        ImGui_ImplOpenGL3_NewFrame();
+        ImGui_ImplGlfw_NewFrame();
+        ImGui::NewFrame();
+        ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+        ImGui::Begin("Sweepers");
+        ImGui::Text("Tool");
+        int m = int(mode_);
+        ImGui::RadioButton("Grab (G)", &m, 0);
+        ImGui::SameLine();
+        ImGui::RadioButton("Twist (T)", &m, 1);
+        ImGui::SameLine();
+        ImGui::RadioButton("Inflate (I)", &m, 2);
+        mode_ = Mode(m);
+        float r = float(radius_), f = float(falloff_);
+        if (ImGui::SliderFloat("radius [ ]", &r, 0.02f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic))
+            radius_ = r;
+        if (ImGui::SliderFloat("falloff", &f, 0.02f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic))
+            falloff_ = f;
+        int mirror = int(mirror_);
+        ImGui::Combo("mirror (M)", &mirror, "none\0x\0y\0z\0");
+        mirror_ = MirrorAxis(mirror);
+        ImGui::Checkbox("wireframe (W)", &wireframe_);
+        ImGui::Separator();
+        ImGui::Text("frame %.1f ms, upload %.1f ms", frameMs_, uploadMs_);
+        ImGui::Text("voxel size %.5g, active voxels %zu", doc_->grid().voxelSize()[0],
+                    std::size_t(doc_->grid().activeVoxelCount()));
+        ImGui::Text("triangles %zu, volume %.5f", doc_->mesher().triangleCount(), volume_);
+        ImGui::Text("last segment: advect %.1f, renorm %.1f, mesh %.1f ms",
+                    1e3 * (report_.stats.growSeconds + report_.stats.sampleSeconds),
+                    1e3 * report_.stats.renormalizeSeconds, 1e3 * report_.meshSeconds);
+        ImGui::Text("undo: %zu strokes, %.1f of %.0f MB", doc_->undoCount(),
+                    double(doc_->undoBytes()) / (1 << 20), double(doc_->undoBudget()) / (1 << 20));
+        if (ImGui::Button("Undo")) onKey('Z', true, false);
+        ImGui::SameLine();
+        if (ImGui::Button("Redo")) onKey('Z', true, true);
+        ImGui::Separator();
+        ImGui::InputText("file", path_, sizeof path_);
+        if (ImGui::Button("Open")) openFile(path_);
+        ImGui::SameLine();
+        if (ImGui::Button("Save")) save(path_);
+        ImGui::SameLine();
+        if (ImGui::Button("New sphere")) {
+            doc_ = std::make_unique<Document>(Document::sphereScript(opt_.voxelSize), ".");
+            renderer_->update(doc_->mesher(), MeshChanges{true, {}});
+            frame();
+        }
+        ImGui::TextWrapped("Save writes .vdb, or the stroke script for .json; .obj/.ply/.stl "
+                           "export the mesh.");
+        if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
+        ImGui::End();
+
+        if (!error_.empty()) ImGui::OpenPopup("Error");
+        if (ImGui::BeginPopupModal("Error", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+            ImGui::TextWrapped("%s", error_.c_str());
+            ImGui::Text("The document was not changed.");
+            if (ImGui::Button("OK")) {
+                error_.clear();
+                ImGui::CloseCurrentPopup();
+            }
+            ImGui::EndPopup();
+        }
+        if (askQuit_) ImGui::OpenPopup("Unsaved changes");
+        if (ImGui::BeginPopupModal("Unsaved changes", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+            ImGui::Text("Save before quitting? (file: %s)", path_);
+            if (ImGui::Button("Save and quit")) {
+                save(path_);
+                if (!doc_->modified()) glfwSetWindowShouldClose(win_, GLFW_TRUE);
+                askQuit_ = false;
+                ImGui::CloseCurrentPopup();
+            }
+            ImGui::SameLine();
+            if (ImGui::Button("Discard")) {
+                discard_ = true;
+                glfwSetWindowShouldClose(win_, GLFW_TRUE);
+                askQuit_ = false;
+                ImGui::CloseCurrentPopup();
+            }
+            ImGui::SameLine();
+            if (ImGui::Button("Cancel")) {
+                askQuit_ = false;
+                ImGui::CloseCurrentPopup();
+            }
+            ImGui::EndPopup();
+        }
+        ImGui::Render();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    }
+
+    void screenshot(const std::string& path) {
+        int fw, fh;
+        glfwGetFramebufferSize(win_, &fw, &fh);
+        std::vector<unsigned char> px(std::size_t(fw) * fh * 3);
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);
+        glReadBuffer(GL_BACK);
+        glReadPixels(0, 0, fw, fh, GL_RGB, GL_UNSIGNED_BYTE, px.data());
+        stbi_flip_vertically_on_write(1);
+        // Atomic: a temporary beside the target, renamed when complete.
+        const std::string tmp = path + ".tmp";
+        if (!stbi_write_png(tmp.c_str(), fw, fh, 3, px.data(), fw * 3) ||
+            std::rename(tmp.c_str(), path.c_str()) != 0) {
+            std::remove(tmp.c_str());
+            throw std::runtime_error(path + ": cannot write the screenshot");
+        }
+    }
+
+    ModelerOptions opt_;
+    GLFWwindow* win_;
+    std::unique_ptr<Document> doc_;
+    std::unique_ptr<GlRenderer> renderer_;
+    OrbitCamera camera_;
+    Mode mode_ = Mode::Grab;
+    Drag drag_ = Drag::None;
+    MirrorAxis mirror_ = MirrorAxis::None;
+    double radius_ = 0.25, falloff_ = 0.25;
+    bool wireframe_ = false, pending_ = false, askQuit_ = false, discard_ = false;
+    double pressX_ = 0, pressY_ = 0, lastX_ = 0, lastY_ = 0, cursorX_ = -1, cursorY_ = -1;
+    glm::dvec3 grab_{0.0}, axis_{0, 0, 1};
+    Placement last_;
+    SegmentReport report_;
+    std::size_t segments_ = 0;
+    double frameMs_ = 0, uploadMs_ = 0, volume_ = 0;
+    char path_[1024] = {};
+    std::string error_, status_;
+};
+
+Modeler* gModeler = nullptr;
+
+bool ctrlDown(GLFWwindow* w) {
+    return glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS ||
+           glfwGetKey(w, GLFW_KEY_RIGHT_CONTROL) == GLFW_PRESS;
+}
+
+// GLFW callbacks; ImGui's backend chains to them, and keeps what falls on its panels.
+void buttonCallback(GLFWwindow* w, int button, int action, int mods) {
+    if (!gModeler || (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse)) return;
+    double x, y;
+    glfwGetCursorPos(w, &x, &y);
+    const int b = button == GLFW_MOUSE_BUTTON_LEFT ? 0 : button == GLFW_MOUSE_BUTTON_RIGHT ? 1 : 2;
+    gModeler->onButton(b, action == GLFW_PRESS, x, y, (mods & GLFW_MOD_SHIFT) != 0);
+}
+void cursorCallback(GLFWwindow*, double x, double y) {
+    if (gModeler) gModeler->onMove(x, y);
+}
+void scrollCallback(GLFWwindow* w, double, double dy) {
+    if (!gModeler || (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureMouse)) return;
+    gModeler->onScroll(dy, ctrlDown(w));
+}
+void dropCallback(GLFWwindow*, int count, const char** paths) {
+    if (gModeler && count > 0) gModeler->openFile(paths[0]);
+}
+void keyCallback(GLFWwindow*, int key, int, int action, int mods) {
+    if (!gModeler || action == GLFW_RELEASE) return;
+    if (ImGui::GetCurrentContext() && ImGui::GetIO().WantCaptureKeyboard) return;
+    int k = key;
+    if (key == GLFW_KEY_LEFT_BRACKET) k = '[';
+    if (key == GLFW_KEY_RIGHT_BRACKET) k = ']';
+    gModeler->onKey(k, (mods & GLFW_MOD_CONTROL) != 0, (mods & GLFW_MOD_SHIFT) != 0);
+}
+
+} // namespace
+
+int runModeler(const ModelerOptions& o) {
+    if (!glfwInit())
+        throw std::runtime_error(
+            "cannot open a window (no display?); sweepers-cli works without one");
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+    glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    glfwWindowHint(GLFW_SAMPLES, 4);
+    GLFWwindow* w = glfwCreateWindow(o.width, o.height, "Sweepers", nullptr, nullptr);
+    if (!w) {
+        glfwTerminate();
+        throw std::runtime_error("cannot create an OpenGL 3.3 core window");
+    }
+    glfwMakeContextCurrent(w);
+    glfwSwapInterval(o.replayInput.empty() && o.screenshot.empty() ? 1 : 0);
+    glfwSetMouseButtonCallback(w, buttonCallback);
+    glfwSetCursorPosCallback(w, cursorCallback);
+    glfwSetScrollCallback(w, scrollCallback);
+    glfwSetKeyCallback(w, keyCallback);
+    glfwSetDropCallback(w, dropCallback);
+    IMGUI_CHECKVERSION();
+    ImGui::CreateContext();
+    ImGui::GetIO().IniFilename = nullptr;
+    ImGui::StyleColorsDark();
+    ImGui_ImplGlfw_InitForOpenGL(w, true); // chains to the callbacks above
+    ImGui_ImplOpenGL3_Init("#version 330 core");
+    int code = 1;
+    try {
+        Modeler m(o, w);
+        gModeler = &m;
+        code = m.run();
+        gModeler = nullptr;
+    } catch (...) {
+        gModeler = nullptr;
+        ImGui_ImplOpenGL3_Shutdown();
+        ImGui_ImplGlfw_Shutdown();
+        ImGui::DestroyContext();
+        glfwDestroyWindow(w);
+        glfwTerminate();
+        throw;
+    }
+    ImGui_ImplOpenGL3_Shutdown();
+    ImGui_ImplGlfw_Shutdown();
+    ImGui::DestroyContext();
+    glfwDestroyWindow(w);
+    glfwTerminate();
+    return code;
+}
+
+} // namespace sweepers

@@ -1,0 +1,24 @@
+// The interactive modeler: a GLFW window over a Document, sculpted with the mouse.
+#pragma once
+
+#include <string>
+
+namespace sweepers {
+
+struct ModelerOptions {
+    std::string open; // a .vdb or a stroke script (.json); empty: a unit sphere
+    double voxelSize = 1.0 / 64;
+    int width = 1280, height = 800;
+    std::string screenshot;  // render, write this PNG and exit (after the replay, if any)
+    std::string replayInput; // events to replay; the window closes after the last one
+    std::string saveVdb;     // written when the window closes (for tests and batch use)
+    std::string saveScript;  // the recorded stroke script, written when the window closes
+    bool hideUi = false;     // no panels (clean screenshots)
+    std::string argv0;
+};
+
+// Runs until the window closes; returns the process exit code. Errors before the window
+// opens (bad file, no display) are thrown as std::runtime_error.
+int runModeler(const ModelerOptions& options);
+
+} // namespace sweepers

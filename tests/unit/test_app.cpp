@@ -1,0 +1,67 @@
+// The modeler's window-free parts: the orbit camera and the input replay files.
+#include <cstdio>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "app/camera.h"
+#include "app/input_replay.h"
+
+using namespace sweepers;
+
+TEST(OrbitCamera, CentrePixelLooksAtTheTargetAndDragsFollowTheCursor) {
+    OrbitCamera c;
+    c.target = {0.2, -0.1, 0.3};
+    c.yaw = 1.1;
+    c.pitch = -0.4;
+    const Ray r = c.rayThrough(400, 300, 800, 600);
+    const glm::dvec3 toTarget = glm::normalize(c.target - r.origin);
+    EXPECT_NEAR(glm::dot(r.direction, toTarget), 1.0, 1e-9);
+    // A drag across the whole width moves a point at the target by the view's width there.
+    const glm::dvec3 d = c.dragInViewPlane(c.target, 0, 300, 800, 300, 800, 600);
+    const double height = 2.0 * c.distance * std::tan(0.5 * c.fovY);
+    EXPECT_NEAR(glm::length(d), height * 800.0 / 600.0, 1e-6);
+    EXPECT_NEAR(glm::dot(d, c.eye() - c.target), 0.0, 1e-9); // in the view plane
+    c.frame({-1, -1, -1}, {1, 1, 1});
+    EXPECT_NEAR(glm::length(c.target), 0.0, 1e-12);
+}
+
+namespace {
+std::string refused(const std::string& text) {
+    const std::string path = ::testing::TempDir() + "/events.json";
+    std::ofstream(path) << text;
+    try {
+        readInputEvents(path);
+    } catch (const std::runtime_error& e) {
+        return e.what();
+    }
+    return "";
+}
+} // namespace
+
+TEST(InputReplay, ReadsEventsAndRefusesBadOnesWithTheirPlace) {
+    const std::string path = ::testing::TempDir() + "/ok.json";
+    std::ofstream(path) << R"({"events": [
+        {"frame": 1, "type": "press", "button": "right", "x": 10, "y": 20},
+        {"frame": 1, "type": "move", "x": 11, "y": 21},
+        {"frame": 3, "type": "key", "key": "z", "ctrl": true, "shift": true},
+        {"frame": 4, "type": "drop", "path": "a.vdb"}]})";
+    const auto ev = readInputEvents(path);
+    ASSERT_EQ(ev.size(), 4u);
+    EXPECT_EQ(ev[0].button, 1);
+    EXPECT_EQ(ev[2].key, 'Z');
+    EXPECT_TRUE(ev[2].ctrl && ev[2].shift);
+    EXPECT_EQ(ev[3].path, "a.vdb");
+
+    EXPECT_NE(refused("{\"events\": 3}").find("expected"), std::string::npos);
+    EXPECT_NE(refused("not json").find("parse error"), std::string::npos);
+    EXPECT_NE(
+        refused(R"({"events": [{"frame": 1, "type": "wiggle"}]})").find("/events/0: unknown type"),
+        std::string::npos);
+    EXPECT_NE(refused(R"({"events": [{"frame": 2, "type": "move", "x": 1, "y": 1},
+                                     {"frame": 1, "type": "move", "x": 1, "y": 1}]})")
+                  .find("/events/1: frames must not go back"),
+              std::string::npos);
+    EXPECT_NE(refused(R"({"events": [{"frame": 1, "type": "move", "x": 1}]})").find("/events/0"),
+              std::string::npos);
+}
