@@ -1,20 +1,28 @@
 #include "app/document.h"
 
+#include <cmath>
 #include <filesystem>
 #include <stdexcept>
 
 #include "deform/sweep.h"
+#include "io/mesh_file.h"
 #include "io/vdb_file.h"
 #include "levelset/advect.h"
 #include "levelset/level_set.h"
 
 namespace sweepers {
 
-Document::Document(StrokeScript script, const std::string& scriptDir)
+Document::Document(StrokeScript script, const std::string& scriptDir, const Progress& progress)
     : script_(std::move(script)), scriptDir_(scriptDir) {
     RunOptions options;
     grid_ = makeStartGrid(script_, scriptDir_, options);
-    applyStrokes(*grid_, script_, options);
+    if (script_.start.kind == StartShape::Kind::Vdb &&
+        std::abs(grid_->voxelSize()[0] - script_.grid.voxelSize) > 1e-9 * script_.grid.voxelSize)
+        throw std::runtime_error(
+            "the document starts from a VDB file at voxel size " +
+            std::to_string(grid_->voxelSize()[0]) +
+            "; it cannot be replayed at another voxel size (start from a sphere or a mesh)");
+    applyStrokes(*grid_, script_, options, progress);
     markAsDocument(*grid_);
     mesher_.rebuild(*grid_);
 }
@@ -28,9 +36,16 @@ StrokeScript Document::sphereScript(double voxelSize) {
     return s;
 }
 
-Document Document::open(const std::string& path) {
+Document Document::open(const std::string& path, double meshVoxelSize, const Progress& progress) {
     const bool isScript = path.size() >= 5 && path.compare(path.size() - 5, 5, ".json") == 0;
-    if (isScript) return Document(readStrokeScript(path), directoryOf(path));
+    if (isScript) return Document(readStrokeScript(path), directoryOf(path), progress);
+    if (isMeshPath(path)) {
+        // A mesh becomes the start of a new script, at the given voxel size.
+        StrokeScript s = sphereScript(meshVoxelSize);
+        s.start.kind = StartShape::Kind::Mesh;
+        s.start.file = std::filesystem::absolute(path).string();
+        return Document(s, directoryOf(s.start.file), progress);
+    }
     // A VDB: read it first (a clear error for anything but a float level set), then start
     // a script from it.
     const GridPtr g = readLevelSet(path);
@@ -137,7 +152,20 @@ void Document::saveVdb(const std::string& path) {
 }
 
 void Document::saveScript(const std::string& path) {
-    writeStrokeScript(script_, path);
+    // The start file is named so that the script works from wherever it is saved.
+    StrokeScript s = script_;
+    if (s.start.kind != StartShape::Kind::Sphere && !s.start.file.empty() &&
+        s.start.file.front() != '/')
+        s.start.file = std::filesystem::absolute(scriptDir_ + "/" + s.start.file).string();
+    writeStrokeScript(s, path);
+}
+
+Document Document::replayAt(StrokeScript script, const std::string& scriptDir, double voxelSize,
+                            const Progress& progress) {
+    if (!(voxelSize > 0.0) || !std::isfinite(voxelSize))
+        throw std::runtime_error("the voxel size must be a positive number");
+    script.grid.voxelSize = voxelSize;
+    return Document(std::move(script), scriptDir, progress);
 }
 
 } // namespace sweepers

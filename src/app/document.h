@@ -17,11 +17,16 @@ class Document {
   public:
     // Builds the script's start shape and applies its strokes (they become the document's
     // history, not undoable). Throws on bad input, leaving nothing half made.
-    Document(StrokeScript script, const std::string& scriptDir);
+    Document(StrokeScript script, const std::string& scriptDir, const Progress& progress = {});
     // A unit sphere at voxel size h.
     static StrokeScript sphereScript(double voxelSize);
-    // Opens a .vdb (a float level set) or a .json stroke script.
-    static Document open(const std::string& path);
+    // Opens a .vdb (a float level set), a .json stroke script, or imports a mesh
+    // (.obj, .ply, .stl) at `meshVoxelSize`.
+    static Document open(const std::string& path, double meshVoxelSize = 1.0 / 64,
+                         const Progress& progress = {});
+    // A history replayed at another voxel size (a resolution change).
+    static Document replayAt(StrokeScript script, const std::string& scriptDir, double voxelSize,
+                             const Progress& progress = {});
 
     const Grid& grid() const { return *grid_; }
     const SurfaceMesher& mesher() const { return mesher_; }
@@ -49,6 +54,7 @@ class Document {
     void saveVdb(const std::string& path);
     void saveScript(const std::string& path);
     void markSaved() { modified_ = false; }
+    void markModified() { modified_ = true; }
 
     // What changed in the mesh since the last call (for re-upload).
     MeshChanges takeMeshChanges() { return mesher_.takeChanges(); }

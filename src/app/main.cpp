@@ -26,6 +26,8 @@ int main(int argc, char** argv) {
     app.add_option("--save-script", o.saveScript,
                    "write the recorded stroke script here when the window closes");
     app.add_flag("--hide-ui", o.hideUi, "draw no panels");
+    app.add_flag("--latency-report", o.latencyReport,
+                 "print stroke latency (drag event to mesh on screen) by stage at exit");
     app.add_option("--threads", threads, "worker threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
     CLI11_PARSE(app, argc, argv);

@@ -4,9 +4,14 @@
 #include <GL/gl.h>
 #include <GLFW/glfw3.h>
 
+#include <algorithm>
+#include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
+#include <future>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -41,12 +46,19 @@ Eigen::Vector3d toEigen3(const glm::dvec3& v) {
 class Modeler {
   public:
     Modeler(const ModelerOptions& o, GLFWwindow* w) : opt_(o), win_(w) {
-        doc_ = std::make_unique<Document>(o.open.empty()
-                                              ? Document(Document::sphereScript(o.voxelSize), ".")
-                                              : Document::open(o.open));
         renderer_ = std::make_unique<GlRenderer>(findShaderDir(o.argv0));
-        frame();
         std::snprintf(path_, sizeof path_, "%s", o.open.empty() ? "untitled.vdb" : o.open.c_str());
+        voxelSizeInput_ = float(o.voxelSize);
+        if (o.open.empty()) {
+            doc_ = std::make_unique<Document>(Document::sphereScript(o.voxelSize), ".");
+            frame();
+        } else {
+            const std::string path = o.open;
+            const double h = o.voxelSize;
+            startJob("opening " + path, [path, h](const Progress& p) {
+                return std::make_unique<Document>(Document::open(path, h, p));
+            });
+        }
     }
 
     int run() {
@@ -55,26 +67,44 @@ class Modeler {
         const bool batch = !opt_.replayInput.empty() || !opt_.screenshot.empty();
         const int lastFrame = events.empty() ? 1 : events.back().frame + 2;
         std::size_t next = 0;
-        for (int f = 0; !glfwWindowShouldClose(win_); ++f) {
-            const auto t0 = std::chrono::steady_clock::now();
+        // Replayed events count frames in which no long job runs, as a user waits for one.
+        int eventFrame = 0;
+        while (!glfwWindowShouldClose(win_)) {
+            const auto t0 = Clock::now();
             glfwPollEvents();
-            for (; next < events.size() && events[next].frame == f; ++next)
-                dispatch(events[next]);
-            step();
+            pollJob();
+            if (!job_) {
+                for (; next < events.size() && events[next].frame == eventFrame; ++next)
+                    dispatch(events[next]);
+                step();
+            }
+            const auto drawStart = Clock::now();
             draw();
-            if (batch && f >= lastFrame) {
+            if (batch && !job_ && eventFrame >= lastFrame) {
                 if (!opt_.screenshot.empty()) screenshot(opt_.screenshot);
                 glfwSetWindowShouldClose(win_, GLFW_TRUE);
             }
+            if (!job_) ++eventFrame;
             glfwSwapBuffers(win_);
-            frameMs_ =
-                1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            if (measuring_) {
+                // Latency of the segment: from its drag event to the new mesh on screen.
+                glFinish();
+                const auto now = Clock::now();
+                latencies_.push_back(
+                    {1e3 * (report_.stats.growSeconds + report_.stats.sampleSeconds),
+                     1e3 * report_.stats.renormalizeSeconds, 1e3 * report_.meshSeconds, uploadMs_,
+                     1e3 * std::chrono::duration<double>(now - drawStart).count(),
+                     1e3 * std::chrono::duration<double>(now - pendingSince_).count()});
+                measuring_ = false;
+            }
+            frameMs_ = 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
             if (!batch && glfwWindowShouldClose(win_) && doc_->modified() && !discard_) {
                 glfwSetWindowShouldClose(win_, GLFW_FALSE); // ask first
                 askQuit_ = true;
             }
         }
         doc_->endStroke();
+        if (opt_.latencyReport) reportLatency();
         if (!opt_.saveVdb.empty()) doc_->saveVdb(opt_.saveVdb);
         if (!opt_.saveScript.empty()) doc_->saveScript(opt_.saveScript);
         return 0;
@@ -82,6 +112,7 @@ class Modeler {
 
     // --- input, from GLFW callbacks or a replay -------------------------------------
     void onButton(int button, bool press, double x, double y, bool shift) {
+        if (job_ || !doc_) return; // the document is being replaced
         cursorX_ = x;
         cursorY_ = y;
         if (!press) {
@@ -130,7 +161,10 @@ class Modeler {
             camera_.pan(dx / h, dy / h);
             break;
         case Drag::Sculpt:
-            pending_ = true; // coalesced: one segment per frame, at the latest position
+            // Coalesced: one segment per frame, at the latest position; its latency counts
+            // from the first event it absorbs.
+            if (!pending_) pendingSince_ = Clock::now();
+            pending_ = true;
             break;
         case Drag::None:
             break;
@@ -147,6 +181,7 @@ class Modeler {
     }
 
     void onKey(int key, bool ctrl, bool shift) {
+        if (job_ || !doc_) return;
         if (ctrl && key == 'Z') {
             shift ? doc_->redo() : doc_->undo();
             volume_ = doc_->mesher().enclosedVolume();
@@ -202,22 +237,61 @@ class Modeler {
         }
     }
 
-    // Opens a file (dropped on the window, or the Open button); a file that cannot be
-    // opened leaves the current document as it was.
+    // Opens a file (dropped on the window, or the Open button) off the render thread; a
+    // file that cannot be opened leaves the current document as it was. Unsaved changes
+    // are not dropped without asking.
     void openFile(const std::string& path) {
-        try {
-            auto d = std::make_unique<Document>(Document::open(path));
-            doc_ = std::move(d);
-            renderer_->update(doc_->mesher(), MeshChanges{true, {}});
-            frame();
-            std::snprintf(path_, sizeof path_, "%s", path.c_str());
-            status_ = "opened " + path;
-        } catch (const std::exception& e) {
-            fail(e.what());
-        }
+        if (job_) return;
+        const double h = doc_ ? doc_->grid().voxelSize()[0] : opt_.voxelSize;
+        auto open = [this, path, h] {
+            startJob("opening " + path, [path, h](const Progress& p) {
+                return std::make_unique<Document>(Document::open(path, h, p));
+            });
+        };
+        if (doc_ && doc_->modified())
+            confirm("Open " + path + " and discard the unsaved changes?", open);
+        else
+            open();
     }
 
   private:
+    using Maker = std::function<std::unique_ptr<Document>(const Progress&)>;
+    void startJob(const std::string& what, Maker make) {
+        auto done = std::make_shared<std::atomic<std::size_t>>(0);
+        auto total = std::make_shared<std::atomic<std::size_t>>(0);
+        Progress progress = [done, total](std::size_t d, std::size_t t) {
+            *done = d;
+            *total = t;
+        };
+        job_.emplace(
+            Job{std::async(std::launch::async, [make, progress] { return make(progress); }), done,
+                total, what});
+    }
+
+    // Takes the finished job's document, or shows why there is none.
+    void pollJob() {
+        if (!job_ || job_->result.wait_for(std::chrono::seconds(0)) != std::future_status::ready)
+            return;
+        Job job = std::move(*job_);
+        job_.reset();
+        try {
+            doc_ = job.result.get();
+        } catch (const std::exception& e) {
+            if (!doc_) throw; // nothing to keep: the start file itself is bad
+            fail(e.what());
+            return;
+        }
+        drag_ = Drag::None;
+        renderer_->update(doc_->mesher(), MeshChanges{true, {}});
+        frame();
+        status_ = job.what + ": done";
+    }
+
+    void confirm(const std::string& question, std::function<void()> action) {
+        confirmText_ = question;
+        confirmAction_ = std::move(action);
+    }
+
     // Errors go to a dialog, and to stderr for whoever started the modeler.
     void fail(const std::string& message) {
         error_ = message;
@@ -287,11 +361,29 @@ class Modeler {
         try {
             last_ = p;
             report_ = doc_->extendStroke(p);
-            segments_++;
+            measuring_ = true;
         } catch (const std::exception& e) {
             doc_->endStroke();
             drag_ = Drag::None;
             fail(e.what());
+        }
+    }
+
+    void reportLatency() const {
+        static const char* names[] = {"advect", "renorm", "mesh", "upload", "draw", "total"};
+        std::fprintf(stderr, "latency over %zu segments at voxel size %g (ms, p50 / p95):",
+                     latencies_.size(), doc_->grid().voxelSize()[0]);
+        for (int k = 0; k < 6; ++k) {
+            std::vector<double> v;
+            for (const auto& l : latencies_)
+                v.push_back(l[k]);
+            std::sort(v.begin(), v.end());
+            auto at = [&](double q) {
+                return v.empty() ? 0.0
+                                 : v[std::min(v.size() - 1, std::size_t(q * (v.size() - 1) + 0.5))];
+            };
+            std::fprintf(stderr, " %s %.1f / %.1f%s", names[k], at(0.5), at(0.95),
+                         k < 5 ? "," : "\n");
         }
     }
 
@@ -318,12 +410,7 @@ class Modeler {
         }
     }
 
-    void draw() {
-        int fw, fh;
-        glfwGetFramebufferSize(win_, &fw, &fh);
-        glViewport(0, 0, fw, fh);
-        glClearColor(0.16f, 0.17f, 0.19f, 1.0f);
-        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+    void scene(int fw, int fh) {
         const auto t0 = std::chrono::steady_clock::now();
         renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
         uploadMs_ =
@@ -343,13 +430,42 @@ class Modeler {
         const Box b = activeWorldBox(doc_->grid());
         renderer_->draw(camera_.view(), camera_.projection(double(fw) / std::max(fh, 1)),
                         wireframe_, tool, b.min.y());
-        if (!opt_.hideUi) panels();
+    }
+
+    void draw() {
+        int fw, fh;
+        glfwGetFramebufferSize(win_, &fw, &fh);
+        glViewport(0, 0, fw, fh);
+        glClearColor(0.16f, 0.17f, 0.19f, 1.0f);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+        if (doc_) scene(fw, fh);
+        if (!opt_.hideUi || job_) panels();
     }
 
     void panels() {
         ImGui_ImplOpenGL3_NewFrame();
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
+        if (doc_ && !opt_.hideUi) mainPanel();
+        if (job_) {
+            const ImVec2 size = ImGui::GetIO().DisplaySize;
+            ImGui::SetNextWindowPos(ImVec2(size.x * 0.5f, size.y * 0.5f), ImGuiCond_Always,
+                                    ImVec2(0.5f, 0.5f));
+            ImGui::Begin("Working", nullptr,
+                         ImGuiWindowFlags_AlwaysAutoResize | ImGuiWindowFlags_NoCollapse);
+            const std::size_t d = *job_->done, t = *job_->total;
+            ImGui::Text("%s", job_->what.c_str());
+            char label[64];
+            std::snprintf(label, sizeof label, "segment %zu / %zu", d, t);
+            ImGui::ProgressBar(t ? float(d) / float(t) : 0.0f, ImVec2(320, 0), label);
+            ImGui::End();
+        }
+        popups();
+        ImGui::Render();
+        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    }
+
+    void mainPanel() {
         ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
         ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
         ImGui::Begin("Sweepers");
@@ -390,15 +506,43 @@ class Modeler {
         if (ImGui::Button("Save")) save(path_);
         ImGui::SameLine();
         if (ImGui::Button("New sphere")) {
-            doc_ = std::make_unique<Document>(Document::sphereScript(opt_.voxelSize), ".");
-            renderer_->update(doc_->mesher(), MeshChanges{true, {}});
-            frame();
+            auto fresh = [this] {
+                doc_ = std::make_unique<Document>(
+                    Document::sphereScript(doc_->grid().voxelSize()[0]), ".");
+                renderer_->update(doc_->mesher(), MeshChanges{true, {}});
+                frame();
+            };
+            if (doc_->modified())
+                confirm("Start a new sphere and discard the unsaved changes?", fresh);
+            else
+                fresh();
         }
-        ImGui::TextWrapped("Save writes .vdb, or the stroke script for .json; .obj/.ply/.stl "
-                           "export the mesh.");
+        ImGui::TextWrapped("Open reads .vdb and .json, imports .obj/.ply/.stl; Save writes "
+                           ".vdb, the stroke script for .json, a mesh for .obj/.ply/.stl.");
+        ImGui::InputFloat("voxel size", &voxelSizeInput_, 0.0f, 0.0f, "%.6f");
+        if (ImGui::Button("Resample (replay the history at this voxel size)")) {
+            const double h = voxelSizeInput_;
+            StrokeScript script = doc_->script();
+            const std::string dir = doc_->scriptDir();
+            doc_->endStroke();
+            if (!(h >= 1e-4 && h <= 0.5)) {
+                fail("the voxel size must lie between 0.0001 and 0.5");
+            } else {
+                const bool modified = doc_->modified();
+                startJob("resampling to voxel size " + std::to_string(h),
+                         [script, dir, h, modified](const Progress& p) {
+                             auto d =
+                                 std::make_unique<Document>(Document::replayAt(script, dir, h, p));
+                             if (modified) d->markModified();
+                             return d;
+                         });
+            }
+        }
         if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
         ImGui::End();
+    }
 
+    void popups() {
         if (!error_.empty()) ImGui::OpenPopup("Error");
         if (ImGui::BeginPopupModal("Error", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
             ImGui::TextWrapped("%s", error_.c_str());
@@ -432,8 +576,22 @@ class Modeler {
             }
             ImGui::EndPopup();
         }
-        ImGui::Render();
-        ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+        if (!confirmText_.empty()) ImGui::OpenPopup("Confirm");
+        if (ImGui::BeginPopupModal("Confirm", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+            ImGui::Text("%s", confirmText_.c_str());
+            if (ImGui::Button("Yes")) {
+                auto action = std::move(confirmAction_);
+                confirmText_.clear();
+                ImGui::CloseCurrentPopup();
+                action();
+            }
+            ImGui::SameLine();
+            if (ImGui::Button("Cancel")) {
+                confirmText_.clear();
+                ImGui::CloseCurrentPopup();
+            }
+            ImGui::EndPopup();
+        }
     }
 
     void screenshot(const std::string& path) {
@@ -453,6 +611,16 @@ class Modeler {
         }
     }
 
+    struct Job {
+        std::future<std::unique_ptr<Document>> result;
+        std::shared_ptr<std::atomic<std::size_t>> done, total;
+        std::string what;
+    };
+    std::optional<Job> job_;
+    std::string confirmText_;
+    std::function<void()> confirmAction_;
+    float voxelSizeInput_ = 1.0f / 64;
+
     ModelerOptions opt_;
     GLFWwindow* win_;
     std::unique_ptr<Document> doc_;
@@ -467,7 +635,11 @@ class Modeler {
     glm::dvec3 grab_{0.0}, axis_{0, 0, 1};
     Placement last_;
     SegmentReport report_;
-    std::size_t segments_ = 0;
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point pendingSince_;
+    bool measuring_ = false;
+    // Per segment: advect, renorm, mesh, upload, draw (+ swap, finish), total; in ms.
+    std::vector<std::array<double, 6>> latencies_;
     double frameMs_ = 0, uploadMs_ = 0, volume_ = 0;
     char path_[1024] = {};
     std::string error_, status_;

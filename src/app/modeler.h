@@ -9,11 +9,12 @@ struct ModelerOptions {
     std::string open; // a .vdb or a stroke script (.json); empty: a unit sphere
     double voxelSize = 1.0 / 64;
     int width = 1280, height = 800;
-    std::string screenshot;  // render, write this PNG and exit (after the replay, if any)
-    std::string replayInput; // events to replay; the window closes after the last one
-    std::string saveVdb;     // written when the window closes (for tests and batch use)
-    std::string saveScript;  // the recorded stroke script, written when the window closes
-    bool hideUi = false;     // no panels (clean screenshots)
+    std::string screenshot;     // render, write this PNG and exit (after the replay, if any)
+    std::string replayInput;    // events to replay; the window closes after the last one
+    std::string saveVdb;        // written when the window closes (for tests and batch use)
+    std::string saveScript;     // the recorded stroke script, written when the window closes
+    bool hideUi = false;        // no panels (clean screenshots)
+    bool latencyReport = false; // print per-segment latency by stage when the window closes
     std::string argv0;
 };
 

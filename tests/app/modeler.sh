@@ -23,7 +23,16 @@ run --hide-ui --script "$here/dent.json" --screenshot "$tmp/dent.png"
 
 # --- a replayed drag pulls the surface out; the recorded script replays to the same grid
 run --replay-input "$here/drag_a.json" --save "$tmp/a.vdb" --save-script "$tmp/a.json" \
-    --screenshot "$tmp/a.png"
+    --screenshot "$tmp/a.png" --latency-report 2>"$tmp/latency"
+cat "$tmp/latency"
+"$py" - "$tmp/latency" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+m = re.search(r"latency over (\d+) segments", text)
+assert m and int(m.group(1)) >= 3, text
+stage = {k: float(v) for k, v in re.findall(r"(\w+) ([\d.]+) / [\d.]+", text)}
+assert stage["total"] >= stage["advect"] + stage["mesh"] > 0, stage
+PY
 "$cli" info --json "$tmp/default.vdb" >"$tmp/default.info"
 "$cli" info --json "$tmp/a.vdb" >"$tmp/a.info"
 "$py" - "$tmp/default.info" "$tmp/a.info" <<'PY'

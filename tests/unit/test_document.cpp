@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "app/document.h"
+#include "io/mesh_file.h"
 #include "levelset/raycast.h"
 
 using namespace sweepers;
@@ -116,4 +117,40 @@ TEST(Raycast, HitsTheSphereWhereTheRayEntersIt) {
     EXPECT_GT(hit->z(), 0.0);
     EXPECT_FALSE(raycastLevelSet(doc.grid(), {3, 0, 5}, {0, 0, -1}, 100));
     EXPECT_FALSE(raycastLevelSet(doc.grid(), {0, 0, 5}, {0, 0, 1}, 100)); // facing away
+}
+
+TEST(Document, ImportsAMeshAndReplaysItsHistoryAtAnotherVoxelSize) {
+    Document sphere(Document::sphereScript(1.0 / 32), ".");
+    const std::string stl = ::testing::TempDir() + "/sphere.stl";
+    writeMesh(sphere.mesher().weld(), stl);
+    Document imported = Document::open(stl, 1.0 / 32);
+    EXPECT_EQ(imported.script().start.kind, StartShape::Kind::Mesh);
+    EXPECT_NEAR(imported.mesher().enclosedVolume(), sphere.mesher().enclosedVolume(),
+                0.01 * sphere.mesher().enclosedVolume());
+
+    drag(sphere, {0, 0, 1}, {0, 0.2, 0.3}, 3);
+    const Document fine = Document::replayAt(sphere.script(), ".", 1.0 / 48);
+    EXPECT_DOUBLE_EQ(fine.grid().voxelSize()[0], 1.0 / 48);
+    EXPECT_EQ(fine.script().strokes.size(), 1u);
+    RunOptions options;
+    options.voxelSize = 1.0 / 48;
+    GridPtr g = makeStartGrid(sphere.script(), ".", options);
+    applyStrokes(*g, sphere.script(), options);
+    EXPECT_EQ(differingVoxels(*g, fine.grid()), 0u);
+}
+
+TEST(Document, AVdbStartIsNotReplayedAtAnotherVoxelSize) {
+    Document sphere(Document::sphereScript(1.0 / 32), ".");
+    const std::string vdb = ::testing::TempDir() + "/start.vdb";
+    sphere.saveVdb(vdb);
+    const Document opened = Document::open(vdb);
+    EXPECT_EQ(differingVoxels(opened.grid(), sphere.grid()), 0u);
+    try {
+        Document::replayAt(opened.script(), opened.scriptDir(), 1.0 / 40);
+        FAIL() << "a VDB start was replayed at another voxel size";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("cannot be replayed at another voxel size"),
+                  std::string::npos)
+            << e.what();
+    }
 }
