@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <functional>
 #include <future>
 #include <memory>
@@ -688,13 +689,24 @@ int runModeler(const ModelerOptions& o) {
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
-    glfwWindowHint(GLFW_SAMPLES, 4);
-    GLFWwindow* w = glfwCreateWindow(o.width, o.height, "Sweepers", nullptr, nullptr);
-    if (!w) {
-        glfwTerminate();
-        throw std::runtime_error("cannot create an OpenGL 3.3 core window");
+    // 4x multisampling, except on a software rasterizer (llvmpipe without a GPU), where it
+    // costs more than half of every frame: the window is then made again without it.
+    auto open = [&](int samples) {
+        glfwWindowHint(GLFW_SAMPLES, samples);
+        GLFWwindow* w = glfwCreateWindow(o.width, o.height, "Sweepers", nullptr, nullptr);
+        if (!w) {
+            glfwTerminate();
+            throw std::runtime_error("cannot create an OpenGL 3.3 core window");
+        }
+        glfwMakeContextCurrent(w);
+        return w;
+    };
+    GLFWwindow* w = open(4);
+    const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    if (renderer && (std::strstr(renderer, "llvmpipe") || std::strstr(renderer, "softpipe"))) {
+        glfwDestroyWindow(w);
+        w = open(0);
     }
-    glfwMakeContextCurrent(w);
     glfwSwapInterval(o.replayInput.empty() && o.screenshot.empty() ? 1 : 0);
     glfwSetMouseButtonCallback(w, buttonCallback);
     glfwSetCursorPosCallback(w, cursorCallback);
