@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "deform/step_deformation.h"
 #include "deform/sweep.h"
 #include "io/mesh_file.h"
 #include "io/vdb_file.h"
@@ -58,11 +59,33 @@ Document Document::open(const std::string& path, double meshVoxelSize, const Pro
 }
 
 void Document::beginStroke(const ToolSpec& tool, MirrorAxis mirror) {
-    if (inStroke_) endStroke();
     if (tool.path.size() != 1) throw std::invalid_argument("a stroke starts at one placement");
+    beginEdit();
     current_ = SweepStroke{mirror, {tool}};
-    before_ = LeafSnapshot();
     inStroke_ = true;
+}
+
+void Document::beginEdit() {
+    endEdit();
+    applied_.clear();
+    before_ = LeafSnapshot();
+    inEdit_ = true;
+}
+
+// One deformation, exactly as applyStrokes does it (so the recorded script replays to the
+// same grid), after saving the blocks it may change.
+SegmentReport Document::advect(const StepDeformation& deformation) {
+    before_.capture(*grid_, changedRegion(*grid_, deformation));
+    SegmentReport r;
+    r.stroke = script_.strokes.size() + applied_.size();
+    const auto t0 = std::chrono::steady_clock::now();
+    r.stats = advectSegment(*grid_, deformation);
+    const auto t1 = std::chrono::steady_clock::now();
+    r.seconds = std::chrono::duration<double>(t1 - t0).count();
+    r.remeshedLeaves = mesher_.update(*grid_, r.stats.touched);
+    r.meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+    modified_ = true;
+    return r;
 }
 
 SegmentReport Document::extendStroke(const Placement& next) {
@@ -71,58 +94,61 @@ SegmentReport Document::extendStroke(const Placement& next) {
     trial.tools[0].path.push_back(next);
     const Sweep sweep = toSweep(trial); // throws for a motion without a logarithm
     const std::size_t k = sweep.segmentCount() - 1;
-    const SweepSegment segment(sweep, k);
-    // Exactly what applyStrokes does for segment k of this stroke, so the recorded script
-    // replays to the same grid.
-    before_.capture(*grid_, changedRegion(*grid_, segment));
-    SegmentReport r;
-    r.stroke = script_.strokes.size();
+    SegmentReport r = advect(SweepSegment(sweep, k));
     r.segment = k;
-    const auto t0 = std::chrono::steady_clock::now();
-    r.stats = advectSegment(*grid_, segment);
-    const auto t1 = std::chrono::steady_clock::now();
-    r.seconds = std::chrono::duration<double>(t1 - t0).count();
-    r.remeshedLeaves = mesher_.update(*grid_, r.stats.touched);
-    r.meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
     current_ = std::move(trial);
-    modified_ = true;
     return r;
 }
 
-void Document::endStroke() {
-    if (!inStroke_) return;
-    inStroke_ = false;
-    if (current_.tools[0].path.size() < 2) return; // a click without a drag changes nothing
-    script_.strokes.push_back(current_);
-    undo_.push_back({current_, std::move(before_)});
+SegmentReport Document::applyStroke(const Stroke& stroke) {
+    if (!inEdit_ || inStroke_) throw std::logic_error("applyStroke outside an edit");
+    SegmentReport last;
+    const auto parts = planStroke(*grid_, stroke);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+        last = advect(*parts[k]);
+        last.segment = k;
+    }
+    applied_.push_back(stroke);
+    return last;
+}
+
+void Document::endEdit() {
+    if (!inEdit_) return;
+    // A click without a drag changes nothing and is not kept.
+    if (inStroke_ && current_.tools[0].path.size() >= 2) applied_.push_back(current_);
+    inEdit_ = inStroke_ = false;
+    if (applied_.empty()) return;
+    script_.strokes.insert(script_.strokes.end(), applied_.begin(), applied_.end());
+    undo_.push_back({std::move(applied_), std::move(before_)});
+    applied_.clear();
     before_ = LeafSnapshot();
     redo_.clear();
     trimToBudget();
 }
 
 void Document::undo() {
-    if (inStroke_) endStroke();
+    endEdit();
     if (undo_.empty()) return;
     Edit e = std::move(undo_.back());
     undo_.pop_back();
     LeafSnapshot after = LeafSnapshot::sameBlocks(*grid_, e.snapshot);
     e.snapshot.restore(*grid_);
     mesher_.update(*grid_, e.snapshot.bounds());
-    script_.strokes.pop_back();
-    redo_.push_back({std::move(e.stroke), std::move(after)});
+    script_.strokes.resize(script_.strokes.size() - e.strokes.size());
+    redo_.push_back({std::move(e.strokes), std::move(after)});
     modified_ = true;
 }
 
 void Document::redo() {
-    if (inStroke_) endStroke();
+    endEdit();
     if (redo_.empty()) return;
     Edit e = std::move(redo_.back());
     redo_.pop_back();
     LeafSnapshot before = LeafSnapshot::sameBlocks(*grid_, e.snapshot);
     e.snapshot.restore(*grid_);
     mesher_.update(*grid_, e.snapshot.bounds());
-    script_.strokes.push_back(e.stroke);
-    undo_.push_back({std::move(e.stroke), std::move(before)});
+    script_.strokes.insert(script_.strokes.end(), e.strokes.begin(), e.strokes.end());
+    undo_.push_back({std::move(e.strokes), std::move(before)});
     modified_ = true;
     trimToBudget();
 }

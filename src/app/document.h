@@ -34,11 +34,17 @@ class Document {
     const std::string& scriptDir() const { return scriptDir_; }
 
     // Sculpting: a sweep of one tool whose path grows by one placement per drag event;
-    // each new placement is advected at once as one segment.
+    // each new placement is advected at once as one segment. One undo step.
     void beginStroke(const ToolSpec& tool, MirrorAxis mirror);
     bool inStroke() const { return inStroke_; }
     SegmentReport extendStroke(const Placement& next);
-    void endStroke();
+    void endStroke() { endEdit(); }
+
+    // Whole strokes (swirls, inflations, or complete sweeps) applied one after another;
+    // those applied between beginEdit and endEdit are one undo step (one drag).
+    void beginEdit();
+    SegmentReport applyStroke(const Stroke& stroke);
+    void endEdit();
 
     bool canUndo() const { return !undo_.empty(); }
     bool canRedo() const { return !redo_.empty(); }
@@ -61,9 +67,10 @@ class Document {
 
   private:
     struct Edit {
-        Stroke stroke;
-        LeafSnapshot snapshot; // undo stack: before the stroke; redo stack: after it
+        std::vector<Stroke> strokes;
+        LeafSnapshot snapshot; // undo stack: before the strokes; redo stack: after them
     };
+    SegmentReport advect(const StepDeformation& deformation);
     void trimToBudget();
 
     StrokeScript script_;
@@ -73,8 +80,9 @@ class Document {
     std::deque<Edit> undo_;
     std::vector<Edit> redo_;
     std::size_t budget_ = std::size_t(512) << 20;
-    bool inStroke_ = false, modified_ = false;
+    bool inEdit_ = false, inStroke_ = false, modified_ = false;
     SweepStroke current_;
+    std::vector<Stroke> applied_; // strokes of the edit in progress
     LeafSnapshot before_;
 };
 

@@ -34,7 +34,10 @@ namespace sweepers {
 
 namespace {
 
-enum class Mode { Grab, Twist, Inflate };
+// Grab, twist and inflate are sweeps (one segment per frame); swirl moves clay while
+// keeping its volume (one swirl ring per frame, 4.1); clay adds material (Decaudin's
+// inflation, 2.30) under the cursor.
+enum class Mode { Grab, Twist, Inflate, Swirl, Clay };
 enum class Drag { None, Sculpt, Orbit, Pan };
 
 glm::dvec3 toGlm(const Eigen::Vector3d& v) {
@@ -138,14 +141,35 @@ class Modeler {
         }
         grab_ = *hit;
         axis_ = glm::normalize(camera_.eye() - camera_.target);
+        last_ = placementAt(x, y);
+        drag_ = Drag::Sculpt;
+        pending_ = false;
+        if (mode_ == Mode::Swirl || mode_ == Mode::Clay) {
+            doc_->beginEdit();
+            if (mode_ == Mode::Clay) {
+                pendingSince_ = Clock::now();
+                dab(grab_);
+            }
+            return;
+        }
         ToolSpec tool;
         tool.shape = "ball";
         tool.size = Eigen::Vector3d::Constant(radius_);
         tool.falloff = falloff_;
-        tool.path = {placementAt(x, y)};
+        tool.path = {last_};
         doc_->beginStroke(tool, mirror_);
-        drag_ = Drag::Sculpt;
-        pending_ = false;
+    }
+
+    // Clay mode: one inflation of the tool's radius (2.30) centred half a radius under the
+    // surface point p (along the view ray), so that it adds the whole ball (a centre inside
+    // the material gives the inserted ball its sign).
+    void dab(const glm::dvec3& p) {
+        const glm::dvec3 in = p + 0.5 * radius_ * glm::normalize(p - camera_.eye());
+        report_ = doc_->applyStroke(InflateStroke{toEigen3(in), radius_});
+        lastDab_ = p;
+        dabX_ = cursorX_;
+        dabY_ = cursorY_;
+        measuring_ = true;
     }
 
     void onMove(double x, double y) {
@@ -195,6 +219,12 @@ class Modeler {
                 break;
             case 'T':
                 mode_ = Mode::Twist;
+                break;
+            case 'S':
+                mode_ = Mode::Swirl;
+                break;
+            case 'C':
+                mode_ = Mode::Clay;
                 break;
             case 'I':
                 mode_ = Mode::Inflate;
@@ -339,6 +369,8 @@ class Modeler {
         p.t = toEigen3(grab_);
         switch (mode_) {
         case Mode::Grab:
+        case Mode::Swirl:
+        case Mode::Clay:
             p.t = toEigen3(grab_ + camera_.dragInViewPlane(grab_, pressX_, pressY_, x, y, w, h));
             break;
         case Mode::Twist:
@@ -357,11 +389,32 @@ class Modeler {
     void step() {
         if (drag_ != Drag::Sculpt || !pending_) return;
         pending_ = false;
-        const Placement p = placementAt(cursorX_, cursorY_);
-        if (p == last_) return;
         try {
-            last_ = p;
-            report_ = doc_->extendStroke(p);
+            if (mode_ == Mode::Clay) {
+                // A new dab once the cursor has moved half a radius (in the view plane: the
+                // surface under a still cursor rises with every dab).
+                int w, h;
+                glfwGetWindowSize(win_, &w, &h);
+                const double moved = glm::length(
+                    camera_.dragInViewPlane(lastDab_, dabX_, dabY_, cursorX_, cursorY_, w, h));
+                if (moved < 0.5 * radius_) return;
+                if (const auto hit = pick(cursorX_, cursorY_)) dab(*hit);
+                return;
+            }
+            const Placement p = placementAt(cursorX_, cursorY_);
+            if (p == last_) return;
+            if (mode_ == Mode::Swirl) {
+                // A swirl ring carries the clay from the last position to this one.
+                SwirlStroke sw;
+                sw.at = last_.t;
+                sw.move = p.t - last_.t;
+                sw.radius = radius_;
+                last_ = p;
+                report_ = doc_->applyStroke(sw);
+            } else {
+                last_ = p;
+                report_ = doc_->extendStroke(p);
+            }
             measuring_ = true;
         } catch (const std::exception& e) {
             doc_->endStroke();
@@ -477,6 +530,9 @@ class Modeler {
         ImGui::RadioButton("Twist (T)", &m, 1);
         ImGui::SameLine();
         ImGui::RadioButton("Inflate (I)", &m, 2);
+        ImGui::RadioButton("Swirl, keeps volume (S)", &m, 3);
+        ImGui::SameLine();
+        ImGui::RadioButton("Add clay (C)", &m, 4);
         mode_ = Mode(m);
         float r = float(radius_), f = float(falloff_);
         if (ImGui::SliderFloat("radius [ ]", &r, 0.02f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic))
@@ -633,7 +689,8 @@ class Modeler {
     double radius_ = 0.25, falloff_ = 0.25;
     bool wireframe_ = false, pending_ = false, askQuit_ = false, discard_ = false;
     double pressX_ = 0, pressY_ = 0, lastX_ = 0, lastY_ = 0, cursorX_ = -1, cursorY_ = -1;
-    glm::dvec3 grab_{0.0}, axis_{0, 0, 1};
+    glm::dvec3 grab_{0.0}, axis_{0, 0, 1}, lastDab_{0.0};
+    double dabX_ = 0, dabY_ = 0;
     Placement last_;
     SegmentReport report_;
     using Clock = std::chrono::steady_clock;

@@ -49,6 +49,26 @@ GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir,
     return nullptr;
 }
 
+std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& s) {
+    // Planned when the stroke comes: an inflation's reach is the shape as it is then.
+    std::vector<std::unique_ptr<StepDeformation>> parts;
+    const Box reach = activeWorldBox(grid).expanded(2 * grid.voxelSize()[0]);
+    if (const auto* sweep = std::get_if<SweepStroke>(&s)) {
+        const Sweep sw = toSweep(*sweep);
+        for (std::size_t k = 0; k < sw.segmentCount(); ++k)
+            parts.push_back(std::make_unique<SweepSegment>(sw, k));
+    } else if (const auto* swirl = std::get_if<SwirlStroke>(&s)) {
+        if (swirl->ball > 0.0)
+            parts.push_back(starShapedSwirl(toSwirl(*swirl), swirl->ball, reach));
+        else
+            parts.push_back(std::make_unique<SwirlSegment>(toSwirl(*swirl)));
+    } else {
+        const auto& in = std::get<InflateStroke>(s);
+        parts.push_back(std::make_unique<Inflation>(in.at, in.radius, reach));
+    }
+    return parts;
+}
+
 std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,
                                         const RunOptions& options, const Progress& progress,
                                         const std::function<void(std::size_t)>& after) {
@@ -58,32 +78,12 @@ std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,
         total += std::holds_alternative<SweepStroke>(s)
                      ? toSweep(std::get<SweepStroke>(s)).segmentCount()
                      : 1;
-    // The deformations of one stroke, planned when it comes: an inflation's reach is the
-    // shape as it is then.
-    auto plan = [&](const Stroke& s) {
-        std::vector<std::unique_ptr<StepDeformation>> parts;
-        const Box reach = activeWorldBox(grid).expanded(2 * grid.voxelSize()[0]);
-        if (const auto* sweep = std::get_if<SweepStroke>(&s)) {
-            const Sweep sw = toSweep(*sweep);
-            for (std::size_t k = 0; k < sw.segmentCount(); ++k)
-                parts.push_back(std::make_unique<SweepSegment>(sw, k));
-        } else if (const auto* swirl = std::get_if<SwirlStroke>(&s)) {
-            if (swirl->ball > 0.0)
-                parts.push_back(starShapedSwirl(toSwirl(*swirl), swirl->ball, reach));
-            else
-                parts.push_back(std::make_unique<SwirlSegment>(toSwirl(*swirl)));
-        } else {
-            const auto& in = std::get<InflateStroke>(s);
-            parts.push_back(std::make_unique<Inflation>(in.at, in.radius, reach));
-        }
-        return parts;
-    };
     std::vector<SegmentReport> reports;
     std::size_t done = 0;
     SurfaceMesher mesher;
     if (options.remesh) mesher.rebuild(grid);
     for (std::size_t i = 0; i < script.strokes.size(); ++i) {
-        const auto parts = plan(script.strokes[i]);
+        const auto parts = planStroke(grid, script.strokes[i]);
         for (std::size_t k = 0; k < parts.size(); ++k) {
             const auto t0 = std::chrono::steady_clock::now();
             SegmentReport r;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -32,6 +33,10 @@ using Progress = std::function<void(std::size_t, std::size_t)>;
 // The start grid of a script (sphere, or the vdb / mesh file relative to `scriptDir`).
 GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir,
                       const RunOptions& options);
+
+// The deformations of one stroke, in order: a sweep's segments, or one swirl ring or
+// inflation (whose reach depends on the grid as it is when the stroke comes).
+std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke);
 
 // Applies all strokes; calls `after` (if set) after each stroke with its index.
 std::vector<SegmentReport> applyStrokes(Grid& grid, const StrokeScript& script,

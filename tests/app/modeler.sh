@@ -46,6 +46,26 @@ PY
 "$cli" apply "$tmp/a.json" -o "$tmp/a_replayed.vdb" -q
 "$py" "$here/same_grid.py" "$tmp/a.vdb" "$tmp/a_replayed.vdb"
 
+# --- the volume-preserving swirl drag keeps the volume; a dab of clay adds some ---------
+run --replay-input "$here/swirl_and_clay.json" --save "$tmp/swirl.vdb" --save-script "$tmp/swirl.json"
+"$cli" info --json "$tmp/swirl.vdb" >"$tmp/swirl.info"
+"$py" - "$tmp/default.info" "$tmp/swirl.info" "$tmp/swirl.json" <<'PY'
+import json, sys
+before, after = (json.load(open(p)) for p in sys.argv[1:3])
+strokes = json.load(open(sys.argv[3]))["strokes"]
+swirls = [s for s in strokes if s["type"] == "swirl"]
+dabs = [s for s in strokes if s["type"] == "inflate"]
+assert len(swirls) >= 5 and len(dabs) == 1, [s["type"] for s in strokes]
+r = dabs[0]["radius"]
+ball = 4.0 / 3.0 * 3.141592653589793 * r ** 3
+gain = after["mesh_volume"] - before["mesh_volume"]
+print(f"{len(swirls)} swirls and a dab of clay (ball {ball:.5f}): volume {gain:+.5f}")
+# The swirls move clay without adding any; the dab adds about its ball.
+assert abs(gain - ball) < 0.1 * ball, (gain, ball)
+PY
+"$cli" apply "$tmp/swirl.json" -o "$tmp/swirl_replayed.vdb" -q
+"$py" "$here/same_grid.py" "$tmp/swirl.vdb" "$tmp/swirl_replayed.vdb"
+
 # --- two strokes, undo both, redo one: the grid after the first stroke, exactly --------
 run --replay-input "$here/drag_ab_undo.json" --save "$tmp/undo.vdb" --save-script "$tmp/undo.json"
 "$py" "$here/same_grid.py" "$tmp/a.vdb" "$tmp/undo.vdb"

@@ -102,6 +102,28 @@ TEST(Document, RecordedScriptReplaysToTheSameGrid) {
     drag(doc, {0.7, 0.7, 0}, {-0.2, -0.2, 0.1}, 3);
     doc.undo(); // an undone stroke is not in the script
     drag(doc, {0, 1, 0}, {0, 0.3, 0.1}, 2);
+    // A volume-preserving drag (swirls, one per drag event) and a dab of clay: one undo
+    // step each, replayed like the rest.
+    const GridPtr beforeSwirls = doc.grid().deepCopy();
+    doc.beginEdit();
+    for (int i = 0; i < 3; ++i) {
+        SwirlStroke sw;
+        sw.at = {0.9 + 0.05 * i, 0.2, 0.3};
+        sw.move = {0.05, 0.02, 0};
+        sw.radius = 0.3;
+        doc.applyStroke(sw);
+    }
+    doc.endEdit();
+    ASSERT_GT(differingVoxels(*beforeSwirls, doc.grid()), 100u);
+    doc.beginEdit();
+    doc.applyStroke(InflateStroke{{0, 0, -1}, 0.15});
+    doc.endEdit();
+    doc.undo();
+    doc.undo();
+    EXPECT_EQ(differingVoxels(*beforeSwirls, doc.grid()), 0u);
+    doc.redo();
+    doc.redo();
+    EXPECT_EQ(doc.script().strokes.size(), 6u);
     const StrokeScript replayed = parseStrokeScript(formatStrokeScript(doc.script()), "recorded");
     RunOptions options;
     GridPtr g = makeStartGrid(replayed, ".", options);
