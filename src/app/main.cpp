@@ -25,6 +25,9 @@ int main(int argc, char** argv) {
     app.add_option("--save", o.saveVdb, "write the level set here when the window closes");
     app.add_option("--save-script", o.saveScript,
                    "write the recorded stroke script here when the window closes");
+    app.add_flag("--replay-live", o.replayLive,
+                 "replay at frame pace, not waiting for the sculpting (events are coalesced as "
+                 "when a user drags)");
     app.add_flag("--hide-ui", o.hideUi, "draw no panels");
     app.add_flag("--latency-report", o.latencyReport,
                  "print stroke latency (drag event to mesh on screen) by stage at exit");

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -49,7 +50,8 @@ Eigen::Vector3d toEigen3(const glm::dvec3& v) {
 
 class Modeler {
   public:
-    Modeler(const ModelerOptions& o, GLFWwindow* w) : opt_(o), win_(w) {
+    Modeler(const ModelerOptions& o, GLFWwindow* w)
+        : batch_(!o.replayInput.empty() || !o.screenshot.empty()), opt_(o), win_(w) {
         renderer_ = std::make_unique<GlRenderer>(findShaderDir(o.argv0));
         std::snprintf(path_, sizeof path_, "%s", o.open.empty() ? "untitled.vdb" : o.open.c_str());
         voxelSizeInput_ = float(o.voxelSize);
@@ -68,7 +70,7 @@ class Modeler {
     int run() {
         std::vector<InputEvent> events;
         if (!opt_.replayInput.empty()) events = readInputEvents(opt_.replayInput);
-        const bool batch = !opt_.replayInput.empty() || !opt_.screenshot.empty();
+        const bool batch = batch_;
         const int lastFrame = events.empty() ? 1 : events.back().frame + 2;
         std::size_t next = 0;
         // Replayed events count frames in which no long job runs, as a user waits for one.
@@ -78,17 +80,18 @@ class Modeler {
             glfwPollEvents();
             pollJob();
             if (!job_) {
-                for (; next < events.size() && events[next].frame == eventFrame; ++next)
-                    dispatch(events[next]);
+                if (!busy() || opt_.replayLive)
+                    for (; next < events.size() && events[next].frame == eventFrame; ++next)
+                        dispatch(events[next]);
                 step();
             }
             const auto drawStart = Clock::now();
             draw();
-            if (batch && !job_ && eventFrame >= lastFrame) {
+            if (batch && !job_ && !busy() && drag_ == Drag::None && eventFrame >= lastFrame) {
                 if (!opt_.screenshot.empty()) screenshot(opt_.screenshot);
                 glfwSetWindowShouldClose(win_, GLFW_TRUE);
             }
-            if (!job_) ++eventFrame;
+            if (!job_ && (!busy() || opt_.replayLive)) ++eventFrame;
             glfwSwapBuffers(win_);
             if (measuring_) {
                 // Latency of the segment: from its drag event to the new mesh on screen.
@@ -102,12 +105,14 @@ class Modeler {
                 measuring_ = false;
             }
             frameMs_ = 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
-            if (!batch && glfwWindowShouldClose(win_) && doc_->modified() && !discard_) {
+            if (!batch && glfwWindowShouldClose(win_) && !busy() && doc_->modified() && !discard_) {
                 glfwSetWindowShouldClose(win_, GLFW_FALSE); // ask first
                 askQuit_ = true;
             }
         }
-        doc_->endStroke();
+        if (busy()) work_.wait();
+        collect();
+        doc_->endEdit();
         if (opt_.latencyReport) reportLatency();
         if (!opt_.saveVdb.empty()) doc_->saveVdb(opt_.saveVdb);
         if (!opt_.saveScript.empty()) doc_->saveScript(opt_.saveScript);
@@ -121,13 +126,16 @@ class Modeler {
         cursorY_ = y;
         if (!press) {
             if (drag_ == Drag::Sculpt) {
-                step(); // the last position counts
-                doc_->endStroke();
-                volume_ = doc_->mesher().enclosedVolume();
+                // The last position counts; the drag ends once its work is done.
+                pending_ = true;
+                releasing_ = true;
+                step();
+            } else {
+                drag_ = Drag::None;
             }
-            drag_ = Drag::None;
             return;
         }
+        if (busy() || drag_ == Drag::Sculpt) return;
         pressX_ = lastX_ = x;
         pressY_ = lastY_ = y;
         if (button == 1 || button == 2 || (button == 0 && shift)) {
@@ -148,6 +156,8 @@ class Modeler {
             doc_->beginEdit();
             if (mode_ == Mode::Clay) {
                 pendingSince_ = Clock::now();
+                cursorX_ = x;
+                cursorY_ = y;
                 dab(grab_);
             }
             return;
@@ -165,11 +175,12 @@ class Modeler {
     // the material gives the inserted ball its sign).
     void dab(const glm::dvec3& p) {
         const glm::dvec3 in = p + 0.5 * radius_ * glm::normalize(p - camera_.eye());
-        report_ = doc_->applyStroke(InflateStroke{toEigen3(in), radius_});
+        const InflateStroke stroke{toEigen3(in), radius_};
+        Document* doc = doc_.get();
+        launch([doc, stroke] { return doc->applyStroke(stroke); });
         lastDab_ = p;
         dabX_ = cursorX_;
         dabY_ = cursorY_;
-        measuring_ = true;
     }
 
     void onMove(double x, double y) {
@@ -207,12 +218,13 @@ class Modeler {
 
     void onKey(int key, bool ctrl, bool shift) {
         if (job_ || !doc_) return;
+        if (ctrl && busy()) return; // undo and save wait for the sculpting to finish
         if (ctrl && key == 'Z') {
             shift ? doc_->redo() : doc_->undo();
             volume_ = doc_->mesher().enclosedVolume();
         } else if (ctrl && key == 'S') {
             save(path_);
-        } else if (!ctrl) {
+        } else if (!ctrl && !(drag_ == Drag::Sculpt && std::isalpha(key))) {
             switch (key) {
             case 'G':
                 mode_ = Mode::Grab;
@@ -230,7 +242,7 @@ class Modeler {
                 mode_ = Mode::Inflate;
                 break;
             case 'F':
-                frame();
+                if (!busy()) frame();
                 break;
             case 'W':
                 wireframe_ = !wireframe_;
@@ -272,7 +284,7 @@ class Modeler {
     // file that cannot be opened leaves the current document as it was. Unsaved changes
     // are not dropped without asking.
     void openFile(const std::string& path) {
-        if (job_) return;
+        if (job_ || busy()) return;
         const double h = doc_ ? doc_->grid().voxelSize()[0] : opt_.voxelSize;
         auto open = [this, path, h] {
             startJob("opening " + path, [path, h](const Progress& p) {
@@ -385,11 +397,45 @@ class Modeler {
         return p;
     }
 
-    // One sweep segment per frame for the latest cursor position of a drag.
-    void step() {
-        if (drag_ != Drag::Sculpt || !pending_) return;
-        pending_ = false;
+    // The sculpting of a frame runs off the render thread; while it runs, the render thread
+    // keeps drawing what it has and touches neither the grid nor the mesh. A replay waits
+    // for each piece, so it is deterministic: one piece per event frame.
+    bool busy() const { return work_.valid(); }
+
+    void launch(std::function<SegmentReport()> task) {
+        work_ = std::async(std::launch::async, std::move(task));
+        if (batch_ && !opt_.replayLive) work_.wait();
+    }
+
+    // Takes finished work (its report, or why it failed).
+    void collect() {
+        if (!busy() || work_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
         try {
+            report_ = work_.get();
+            measuring_ = true;
+        } catch (const std::exception& e) {
+            doc_->endEdit();
+            drag_ = Drag::None;
+            releasing_ = pending_ = false;
+            fail(e.what());
+        }
+    }
+
+    void finishDrag() {
+        doc_->endEdit();
+        volume_ = doc_->mesher().enclosedVolume();
+        drag_ = Drag::None;
+        releasing_ = false;
+    }
+
+    // One piece of sculpting per frame for the latest cursor position of a drag: a sweep
+    // segment, a swirl ring or a dab of clay.
+    void step() {
+        collect();
+        if (busy() || drag_ != Drag::Sculpt) return;
+        if (pending_) {
+            pending_ = false;
+            Document* doc = doc_.get();
             if (mode_ == Mode::Clay) {
                 // A new dab once the cursor has moved half a radius (in the view plane: the
                 // surface under a still cursor rises with every dab).
@@ -397,30 +443,28 @@ class Modeler {
                 glfwGetWindowSize(win_, &w, &h);
                 const double moved = glm::length(
                     camera_.dragInViewPlane(lastDab_, dabX_, dabY_, cursorX_, cursorY_, w, h));
-                if (moved < 0.5 * radius_) return;
-                if (const auto hit = pick(cursorX_, cursorY_)) dab(*hit);
+                if (moved >= 0.5 * radius_) {
+                    if (const auto hit = pick(cursorX_, cursorY_)) {
+                        dab(*hit);
+                        return;
+                    }
+                }
+            } else if (const Placement p = placementAt(cursorX_, cursorY_); !(p == last_)) {
+                if (mode_ == Mode::Swirl) {
+                    // A swirl ring carries the clay from the last position to this one.
+                    SwirlStroke sw;
+                    sw.at = last_.t;
+                    sw.move = p.t - last_.t;
+                    sw.radius = radius_;
+                    launch([doc, sw] { return doc->applyStroke(sw); });
+                } else {
+                    launch([doc, p] { return doc->extendStroke(p); });
+                }
+                last_ = p;
                 return;
             }
-            const Placement p = placementAt(cursorX_, cursorY_);
-            if (p == last_) return;
-            if (mode_ == Mode::Swirl) {
-                // A swirl ring carries the clay from the last position to this one.
-                SwirlStroke sw;
-                sw.at = last_.t;
-                sw.move = p.t - last_.t;
-                sw.radius = radius_;
-                last_ = p;
-                report_ = doc_->applyStroke(sw);
-            } else {
-                last_ = p;
-                report_ = doc_->extendStroke(p);
-            }
-            measuring_ = true;
-        } catch (const std::exception& e) {
-            doc_->endStroke();
-            drag_ = Drag::None;
-            fail(e.what());
         }
+        if (releasing_) finishDrag();
     }
 
     void reportLatency() const {
@@ -465,25 +509,29 @@ class Modeler {
     }
 
     void scene(int fw, int fh) {
-        const auto t0 = std::chrono::steady_clock::now();
-        renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
-        uploadMs_ =
-            1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        if (!busy()) {
+            const auto t0 = std::chrono::steady_clock::now();
+            renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
+            uploadMs_ =
+                1e3 * std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            groundY_ = activeWorldBox(doc_->grid()).min.y();
+            info_ = {doc_->grid().voxelSize()[0], std::size_t(doc_->grid().activeVoxelCount()),
+                     doc_->mesher().triangleCount(), doc_->undoCount(), doc_->undoBytes()};
+        }
         ToolOverlay tool;
         tool.radius = radius_;
         tool.falloff = falloff_;
         if (drag_ == Drag::Sculpt) {
-            tool.visible = true;
+            tool.visible = mode_ != Mode::Clay;
             tool.center = toGlm(last_.t);
-        } else if (drag_ == Drag::None) {
+        } else if (drag_ == Drag::None && !busy()) {
             if (const auto hit = pick(cursorX_, cursorY_)) {
                 tool.visible = true;
                 tool.center = *hit;
             }
         }
-        const Box b = activeWorldBox(doc_->grid());
         renderer_->draw(camera_.view(), camera_.projection(double(fw) / std::max(fh, 1)),
-                        wireframe_, tool, b.min.y());
+                        wireframe_, tool, groundY_);
     }
 
     void draw() {
@@ -524,6 +572,7 @@ class Modeler {
         ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
         ImGui::Begin("Sweepers");
         ImGui::Text("Tool");
+        ImGui::BeginDisabled(drag_ == Drag::Sculpt);
         int m = int(mode_);
         ImGui::RadioButton("Grab (G)", &m, 0);
         ImGui::SameLine();
@@ -534,6 +583,7 @@ class Modeler {
         ImGui::SameLine();
         ImGui::RadioButton("Add clay (C)", &m, 4);
         mode_ = Mode(m);
+        ImGui::EndDisabled();
         float r = float(radius_), f = float(falloff_);
         if (ImGui::SliderFloat("radius [ ]", &r, 0.02f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic))
             radius_ = r;
@@ -545,14 +595,15 @@ class Modeler {
         ImGui::Checkbox("wireframe (W)", &wireframe_);
         ImGui::Separator();
         ImGui::Text("frame %.1f ms, upload %.1f ms", frameMs_, uploadMs_);
-        ImGui::Text("voxel size %.5g, active voxels %zu", doc_->grid().voxelSize()[0],
-                    std::size_t(doc_->grid().activeVoxelCount()));
-        ImGui::Text("triangles %zu, volume %.5f", doc_->mesher().triangleCount(), volume_);
+        ImGui::Text("voxel size %.5g, active voxels %zu", info_.voxelSize, info_.activeVoxels);
+        ImGui::Text("triangles %zu, volume %.5f", info_.triangles, volume_);
         ImGui::Text("last segment: advect %.1f, renorm %.1f, mesh %.1f ms",
                     1e3 * (report_.stats.growSeconds + report_.stats.sampleSeconds),
                     1e3 * report_.stats.renormalizeSeconds, 1e3 * report_.meshSeconds);
-        ImGui::Text("undo: %zu strokes, %.1f of %.0f MB", doc_->undoCount(),
-                    double(doc_->undoBytes()) / (1 << 20), double(doc_->undoBudget()) / (1 << 20));
+        ImGui::Text("undo: %zu strokes, %.1f of %.0f MB", info_.undoCount,
+                    double(info_.undoBytes) / (1 << 20), double(doc_->undoBudget()) / (1 << 20));
+        // Nothing that changes the document while a drag is being sculpted.
+        ImGui::BeginDisabled(busy() || drag_ == Drag::Sculpt);
         if (ImGui::Button("Undo")) onKey('Z', true, false);
         ImGui::SameLine();
         if (ImGui::Button("Redo")) onKey('Z', true, true);
@@ -595,6 +646,7 @@ class Modeler {
                          });
             }
         }
+        ImGui::EndDisabled();
         if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
         ImGui::End();
     }
@@ -674,6 +726,13 @@ class Modeler {
         std::string what;
     };
     std::optional<Job> job_;
+    std::future<SegmentReport> work_;
+    bool batch_ = false, releasing_ = false;
+    double groundY_ = -1.0;
+    struct Info {
+        double voxelSize = 0;
+        std::size_t activeVoxels = 0, triangles = 0, undoCount = 0, undoBytes = 0;
+    } info_;
     std::string confirmText_;
     std::function<void()> confirmAction_;
     float voxelSizeInput_ = 1.0f / 64;

@@ -11,6 +11,7 @@ struct ModelerOptions {
     int width = 1280, height = 800;
     std::string screenshot;     // render, write this PNG and exit (after the replay, if any)
     std::string replayInput;    // events to replay; the window closes after the last one
+    bool replayLive = false;    // replay at frame pace, not waiting for the sculpting
     std::string saveVdb;        // written when the window closes (for tests and batch use)
     std::string saveScript;     // the recorded stroke script, written when the window closes
     bool hideUi = false;        // no panels (clean screenshots)

@@ -46,6 +46,14 @@ PY
 "$cli" apply "$tmp/a.json" -o "$tmp/a_replayed.vdb" -q
 "$py" "$here/same_grid.py" "$tmp/a.vdb" "$tmp/a_replayed.vdb"
 
+# --- the same drag at frame pace, sculpting off the render thread (events coalesced):
+#     whatever was applied is in the script, which replays to the same grid ---------------
+run --replay-input "$here/long_drag.json" --replay-live --save "$tmp/live.vdb" \
+    --save-script "$tmp/live.json"
+"$cli" apply "$tmp/live.json" -o "$tmp/live_replayed.vdb" -q
+"$py" "$here/same_grid.py" "$tmp/live.vdb" "$tmp/live_replayed.vdb"
+"$py" -c 'import json,sys; p=json.load(open(sys.argv[1]))["strokes"][0]["tools"][0]["path"]; print(f"live drag: {len(p) - 1} segments for 61 events"); assert len(p) >= 3' "$tmp/live.json"
+
 # --- the volume-preserving swirl drag keeps the volume; a dab of clay adds some ---------
 run --replay-input "$here/swirl_and_clay.json" --save "$tmp/swirl.vdb" --save-script "$tmp/swirl.json"
 "$cli" info --json "$tmp/swirl.vdb" >"$tmp/swirl.info"
