@@ -250,11 +250,11 @@ class Modeler {
             case 'M':
                 mirror_ = MirrorAxis((int(mirror_) + 1) % 4);
                 break;
-            case '[':
-                radius_ = std::max(0.02, radius_ / 1.1);
+            case '[': // with shift: the falloff
+                (shift ? falloff_ : radius_) = std::max(0.02, (shift ? falloff_ : radius_) / 1.1);
                 break;
             case ']':
-                radius_ = std::min(2.0, radius_ * 1.1);
+                (shift ? falloff_ : radius_) = std::min(2.0, (shift ? falloff_ : radius_) * 1.1);
                 break;
             case GLFW_KEY_LEFT:
                 camera_.orbit(-0.1, 0);
@@ -585,9 +585,11 @@ class Modeler {
         mode_ = Mode(m);
         ImGui::EndDisabled();
         float r = float(radius_), f = float(falloff_);
-        if (ImGui::SliderFloat("radius [ ]", &r, 0.02f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic))
+        if (ImGui::SliderFloat("radius  [ ]", &r, 0.02f, 1.0f, "%.3f",
+                               ImGuiSliderFlags_Logarithmic))
             radius_ = r;
-        if (ImGui::SliderFloat("falloff", &f, 0.02f, 1.0f, "%.3f", ImGuiSliderFlags_Logarithmic))
+        if (ImGui::SliderFloat("falloff  shift [ ]", &f, 0.02f, 1.0f, "%.3f",
+                               ImGuiSliderFlags_Logarithmic))
             falloff_ = f;
         int mirror = int(mirror_);
         ImGui::Combo("mirror (M)", &mirror, "none\0x\0y\0z\0");
