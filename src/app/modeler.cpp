@@ -105,6 +105,7 @@ class Modeler {
                 measuring_ = false;
             }
             frameMs_ = 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
+            if (drag_ == Drag::None && !busy() && !job_) idleFrames_.push_back(frameMs_);
             if (!batch && glfwWindowShouldClose(win_) && !busy() && doc_->modified() && !discard_) {
                 glfwSetWindowShouldClose(win_, GLFW_FALSE); // ask first
                 askQuit_ = true;
@@ -483,6 +484,11 @@ class Modeler {
             std::fprintf(stderr, " %s %.1f / %.1f%s", names[k], at(0.5), at(0.95),
                          k < 5 ? "," : "\n");
         }
+        std::vector<double> idle = idleFrames_;
+        std::sort(idle.begin(), idle.end());
+        if (!idle.empty())
+            std::fprintf(stderr, "frame time when not sculpting (ms, p50 over %zu frames): %.1f\n",
+                         idle.size(), idle[idle.size() / 2]);
     }
 
     void frame() {
@@ -569,7 +575,7 @@ class Modeler {
 
     void mainPanel() {
         ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-        ImGui::SetNextWindowSize(ImVec2(300, 0), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
         ImGui::Begin("Sweepers");
         ImGui::Text("Tool");
         ImGui::BeginDisabled(drag_ == Drag::Sculpt);
@@ -759,6 +765,7 @@ class Modeler {
     bool measuring_ = false;
     // Per segment: advect, renorm, mesh, upload, draw (+ swap, finish), total; in ms.
     std::vector<std::array<double, 6>> latencies_;
+    std::vector<double> idleFrames_;
     double frameMs_ = 0, uploadMs_ = 0, volume_ = 0;
     char path_[1024] = {};
     std::string error_, status_;
