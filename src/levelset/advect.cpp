@@ -29,10 +29,13 @@ double since(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// Resamples every active voxel of `grid` inside `box` from `source` at map(x).
+// Resamples every active voxel of `grid` inside `box` from `source` at map(x), and marks in
+// `changed` the voxels whose value changed (where the deformation is the identity, a sample
+// at a voxel centre returns its value exactly).
 template <typename Map>
 std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& box, const Map& map,
-                     Sampling sampling) {
+                     Sampling sampling, openvdb::MaskGrid& changed) {
+    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> marks;
     openvdb::tree::LeafManager<Grid::TreeType> leaves(grid.tree());
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
@@ -47,14 +50,20 @@ std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& b
                 const openvdb::Coord ijk = it.getCoord();
                 if (!box.isInside(ijk)) continue;
                 const openvdb::Vec3d p = toVdb(map(toEigen(xform.indexToWorld(ijk))));
-                it.setValue(float(sampling == Sampling::Trilinear
-                                      ? trilinear.wsSample(p)
-                                      : sampleMonotoneCubic(acc, source.worldToIndex(p))));
+                const float v = float(sampling == Sampling::Trilinear
+                                          ? trilinear.wsSample(p)
+                                          : sampleMonotoneCubic(acc, source.worldToIndex(p)));
+                if (v != *it || !acc.isValueOn(ijk)) marks.local().push_back(ijk);
+                it.setValue(v);
                 ++n;
             }
         }
         count += n;
     });
+    auto macc = changed.getAccessor();
+    for (const auto& m : marks)
+        for (const openvdb::Coord& c : m)
+            macc.setValueOn(c);
     return count;
 }
 
@@ -165,22 +174,27 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         source->tree().topologyUnion(widen->tree());
         renormalize(*source, indexBox(grid, seg.affectedBox(), int(needed) + 1), FmmOrder::First);
     }
+    // Voxels the band grows into: renormalized (or dropped again) wherever they are.
+    openvdb::MaskGrid::Ptr fresh = mask->deepCopy();
+    fresh->tree().topologyDifference(grid.tree());
     grid.tree().topologyUnion(mask->tree());
     stats.growSeconds = since(t0);
 
     // 2. Sample: composed inverse (default) or one resample per sub-step (5.3.4).
     t0 = Clock::now();
+    const openvdb::MaskGrid::Ptr changed = openvdb::MaskGrid::create();
     if (!options.resampleEachSubStep) {
         if (!source) source = grid.deepCopy();
         stats.sampledVoxels = resample(
             grid, *source, region, [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); },
-            options.sampling);
+            options.sampling, *changed);
     } else {
         for (int k = 0; k < seg.steps(); ++k) {
             GridPtr step = (k == 0 && source) ? source : grid.deepCopy();
             stats.sampledVoxels += resample(
                 grid, *step, region,
-                [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling);
+                [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling,
+                *changed);
         }
     }
     // Voxels inside the region that are not in the band kept their old inactive values,
@@ -192,7 +206,16 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // 3. Renormalize the changed region (and the band around it).
     t0 = Clock::now();
     const openvdb::CoordBBox touched = changedRegion(grid, seg);
-    if (options.renormalize) renormalize(grid, touched, options.renormalization);
+    if (options.renormalize) {
+        // Only where values changed, and as far as the band reaches from there (the nearest
+        // surface of a voxel nearby may have moved): where the deformation is the identity
+        // (outside the tools' coatings, which fill only part of the box) the distances hold.
+        openvdb::tools::dilateActiveValues(changed->tree(), int(std::ceil(halfWidth)) + 1,
+                                           openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                           openvdb::tools::IGNORE_TILES);
+        changed->tree().topologyUnion(fresh->tree());
+        renormalize(grid, touched, *changed, options.renormalization);
+    }
     stats.renormalizeSeconds = since(t0);
     stats.touched = touched;
     return stats;

@@ -33,7 +33,8 @@ class Domain {
   public:
     static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
 
-    Domain(Grid& grid, const openvdb::CoordBBox& region, int margin) {
+    Domain(Grid& grid, const openvdb::CoordBBox& region, int margin,
+           const openvdb::MaskGrid* only) {
         openvdb::CoordBBox outer = region;
         outer.expand(margin);
         for (auto it = grid.tree().beginLeaf(); it; ++it)
@@ -56,11 +57,13 @@ class Domain {
         tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
             const Leaf& leaf = *leaves_[l];
             const bool whole = region.isInside(leaf.getNodeBoundingBox());
+            const auto* mask = only ? only->tree().probeConstLeaf(leaf.origin()) : nullptr;
             for (int off = 0; off < kLeafVoxels; ++off) {
                 const std::size_t i = (l << 9) + off;
                 phi[i] = leaf.getValue(off);
                 active[i] = leaf.isValueOn(off);
-                inRegion[i] = whole || region.isInside(leaf.offsetToGlobalCoord(off));
+                inRegion[i] = (whole || region.isInside(leaf.offsetToGlobalCoord(off))) &&
+                              (!only || (mask && mask->isValueOn(off)));
             }
         });
     }
@@ -122,13 +125,29 @@ float solveUpwind(float m[3], float c[3], int n, float h) {
 
 } // namespace
 
+namespace {
+FmmStats march(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
+               FmmOrder order);
+} // namespace
+
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder order) {
+    return march(grid, region, nullptr, order);
+}
+
+FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid& only,
+                     FmmOrder order) {
+    return march(grid, region, &only, order);
+}
+
+namespace {
+FmmStats march(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
+               FmmOrder order) {
     FmmStats stats;
     if (region.empty()) return stats;
     const float h = float(grid.voxelSize()[0]);
     const float bg = grid.background();
     const float limit = bg; // march as far as the band reaches
-    Domain b(grid, region, 2);
+    Domain b(grid, region, 2, only);
     const std::size_t n = b.size();
     std::vector<float> u(n, kInf);
     std::vector<std::uint8_t> state(n, Far);
@@ -319,6 +338,7 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
     openvdb::tools::pruneLevelSet(grid.tree());
     return stats;
 }
+} // namespace
 
 FmmStats renormalizeAll(Grid& grid, FmmOrder order) {
     openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();

@@ -31,6 +31,10 @@ struct FmmStats {
 // valid narrow band of the grid's half-width there; the tree is pruned afterwards.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region,
                      FmmOrder order = FmmOrder::Second);
+// The same, for the voxels of `region` that are also on in `only` (what a deformation
+// changed, grown by the band): the rest keep their values and act as boundary.
+FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid& only,
+                     FmmOrder order = FmmOrder::Second);
 
 // Renormalizes the whole active band.
 FmmStats renormalizeAll(Grid& grid, FmmOrder order = FmmOrder::Second);
