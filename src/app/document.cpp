@@ -126,30 +126,32 @@ void Document::endEdit() {
     trimToBudget();
 }
 
+// Puts an edit's snapshot back and returns the same edit holding the blocks as they were
+// just before (so undo gives what redo needs, and the other way round).
+Document::Edit Document::swapIn(Edit e) {
+    LeafSnapshot current = LeafSnapshot::sameBlocks(*grid_, e.snapshot);
+    e.snapshot.restore(*grid_);
+    mesher_.update(*grid_, e.snapshot.bounds());
+    modified_ = true;
+    return {std::move(e.strokes), std::move(current)};
+}
+
 void Document::undo() {
     endEdit();
     if (undo_.empty()) return;
-    Edit e = std::move(undo_.back());
+    Edit e = swapIn(std::move(undo_.back()));
     undo_.pop_back();
-    LeafSnapshot after = LeafSnapshot::sameBlocks(*grid_, e.snapshot);
-    e.snapshot.restore(*grid_);
-    mesher_.update(*grid_, e.snapshot.bounds());
     script_.strokes.resize(script_.strokes.size() - e.strokes.size());
-    redo_.push_back({std::move(e.strokes), std::move(after)});
-    modified_ = true;
+    redo_.push_back(std::move(e));
 }
 
 void Document::redo() {
     endEdit();
     if (redo_.empty()) return;
-    Edit e = std::move(redo_.back());
+    Edit e = swapIn(std::move(redo_.back()));
     redo_.pop_back();
-    LeafSnapshot before = LeafSnapshot::sameBlocks(*grid_, e.snapshot);
-    e.snapshot.restore(*grid_);
-    mesher_.update(*grid_, e.snapshot.bounds());
     script_.strokes.insert(script_.strokes.end(), e.strokes.begin(), e.strokes.end());
-    undo_.push_back({std::move(e.strokes), std::move(before)});
-    modified_ = true;
+    undo_.push_back(std::move(e));
     trimToBudget();
 }
 

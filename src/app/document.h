@@ -71,6 +71,7 @@ class Document {
         LeafSnapshot snapshot; // undo stack: before the strokes; redo stack: after them
     };
     SegmentReport advect(const StepDeformation& deformation);
+    Edit swapIn(Edit e);
     void trimToBudget();
 
     StrokeScript script_;

@@ -1,6 +1,5 @@
 #include "mesh/marching_cubes.h"
 
-#include <Eigen/Geometry>
 #include <unordered_map>
 #include <utility>
 
@@ -154,13 +153,8 @@ std::size_t SurfaceMesher::triangleCount() const {
 double SurfaceMesher::enclosedVolume() const {
     double v = 0.0;
     for (const auto& [o, c] : chunks_)
-        for (const Eigen::Vector3i& t : c.triangles) {
-            const Eigen::Vector3d a = c.positions[t[0]].cast<double>();
-            const Eigen::Vector3d b = c.positions[t[1]].cast<double>();
-            const Eigen::Vector3d d = c.positions[t[2]].cast<double>();
-            v += a.dot(b.cross(d));
-        }
-    return v / 6.0;
+        v += sweepers::enclosedVolume(c.positions, c.triangles);
+    return v;
 }
 
 TriangleMesh SurfaceMesher::weld() const {

@@ -42,8 +42,8 @@ class SurfaceMesher {
     // The changes since the last call (a renderer re-uploads only those).
     MeshChanges takeChanges();
     std::size_t triangleCount() const;
-    // Enclosed volume of the chunks' triangles (divergence theorem; a shared edge vertex has
-    // the same coordinates in both chunks, so no welding is needed).
+    // Enclosed volume of the chunks' triangles (a shared edge vertex has the same
+    // coordinates in both chunks, so no welding is needed).
     double enclosedVolume() const;
     // One mesh with the chunks welded along their shared edges.
     TriangleMesh weld() const;

@@ -39,15 +39,20 @@ MeshTopology meshTopology(const TriangleMesh& mesh) {
     return t;
 }
 
-double enclosedVolume(const TriangleMesh& mesh) {
+double enclosedVolume(const std::vector<Eigen::Vector3f>& positions,
+                      const std::vector<Eigen::Vector3i>& triangles) {
     double v = 0.0;
-    for (const Eigen::Vector3i& t : mesh.triangles) {
-        const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>();
-        const Eigen::Vector3d b = mesh.positions[t[1]].cast<double>();
-        const Eigen::Vector3d c = mesh.positions[t[2]].cast<double>();
+    for (const Eigen::Vector3i& t : triangles) {
+        const Eigen::Vector3d a = positions[t[0]].cast<double>();
+        const Eigen::Vector3d b = positions[t[1]].cast<double>();
+        const Eigen::Vector3d c = positions[t[2]].cast<double>();
         v += a.dot(b.cross(c));
     }
     return v / 6.0;
+}
+
+double enclosedVolume(const TriangleMesh& mesh) {
+    return enclosedVolume(mesh.positions, mesh.triangles);
 }
 
 double surfaceArea(const TriangleMesh& mesh) {

@@ -29,6 +29,10 @@ MeshTopology meshTopology(const TriangleMesh& mesh);
 
 // Signed enclosed volume (divergence theorem); positive for outward-facing triangles.
 double enclosedVolume(const TriangleMesh& mesh);
+// The same sum over any triangles (they need not be welded: a closed surface cut into
+// pieces whose shared vertices have equal coordinates gives the same volume).
+double enclosedVolume(const std::vector<Eigen::Vector3f>& positions,
+                      const std::vector<Eigen::Vector3i>& triangles);
 double surfaceArea(const TriangleMesh& mesh);
 
 } // namespace sweepers
