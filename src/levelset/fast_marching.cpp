@@ -126,22 +126,22 @@ float solveUpwind(float m[3], float c[3], int n, float h) {
 } // namespace
 
 namespace {
-FmmStats march(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
-               FmmOrder order);
+FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
+                          const openvdb::MaskGrid* only, FmmOrder order);
 } // namespace
 
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder order) {
-    return march(grid, region, nullptr, order);
+    return renormalizeWhere(grid, region, nullptr, order);
 }
 
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid& only,
                      FmmOrder order) {
-    return march(grid, region, &only, order);
+    return renormalizeWhere(grid, region, &only, order);
 }
 
 namespace {
-FmmStats march(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
-               FmmOrder order) {
+FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
+                          const openvdb::MaskGrid* only, FmmOrder order) {
     FmmStats stats;
     if (region.empty()) return stats;
     const float h = float(grid.voxelSize()[0]);
