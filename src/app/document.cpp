@@ -13,10 +13,11 @@
 
 namespace sweepers {
 
-Document::Document(StrokeScript script, const std::string& scriptDir, const Progress& progress)
-    : script_(std::move(script)), scriptDir_(scriptDir) {
+Document::Document(StrokeScript script, const std::string& scriptDir, const Progress& progress,
+                   GridPtr start)
+    : script_(std::move(script)), scriptDir_(scriptDir), grid_(std::move(start)) {
     RunOptions options;
-    grid_ = makeStartGrid(script_, scriptDir_, options);
+    if (!grid_) grid_ = makeStartGrid(script_, scriptDir_, options);
     if (script_.start.kind == StartShape::Kind::Vdb &&
         std::abs(grid_->voxelSize()[0] - script_.grid.voxelSize) > 1e-9 * script_.grid.voxelSize)
         throw std::runtime_error(
@@ -47,15 +48,16 @@ Document Document::open(const std::string& path, double meshVoxelSize, const Pro
         s.start.file = std::filesystem::absolute(path).string();
         return Document(s, directoryOf(s.start.file), progress);
     }
-    // A VDB: read it first (a clear error for anything but a float level set), then start
-    // a script from it.
-    const GridPtr g = readLevelSet(path);
+    // A VDB: read once (a clear error for anything but a float level set); it is the start
+    // of a new script.
+    GridPtr g = readLevelSet(path);
     StrokeScript s;
     s.grid.voxelSize = g->voxelSize()[0];
     s.grid.halfWidth = halfWidthOf(*g);
     s.start.kind = StartShape::Kind::Vdb;
     s.start.file = std::filesystem::absolute(path).string();
-    return Document(s, directoryOf(s.start.file));
+    const std::string dir = directoryOf(s.start.file);
+    return Document(std::move(s), dir, {}, std::move(g));
 }
 
 void Document::beginStroke(const ToolSpec& tool, MirrorAxis mirror) {

@@ -17,7 +17,8 @@ class Document {
   public:
     // Builds the script's start shape and applies its strokes (they become the document's
     // history, not undoable). Throws on bad input, leaving nothing half made.
-    Document(StrokeScript script, const std::string& scriptDir, const Progress& progress = {});
+    Document(StrokeScript script, const std::string& scriptDir, const Progress& progress = {},
+             GridPtr start = nullptr); // start: the script's start shape, when already made
     // A unit sphere at voxel size h.
     static StrokeScript sphereScript(double voxelSize);
     // Opens a .vdb (a float level set), a .json stroke script, or imports a mesh

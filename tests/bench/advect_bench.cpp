@@ -72,14 +72,10 @@ void registerAdvectBenchmarks() {
             [div, h](benchmark::State& state) {
                 const GridPtr start = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3.0);
                 const Sweep sweep = pull();
-                GridPtr g;
                 AdvectStats stats;
-                for (auto _ : state) {
-                    state.PauseTiming();
-                    g = start->deepCopy();
-                    state.ResumeTiming();
-                    stats = advectSegment(*g, SweepSegment(sweep, 0));
-                }
+                const GridPtr g = timedOnCopies(state, *start, [&](Grid& grid) {
+                    stats = advectSegment(grid, SweepSegment(sweep, 0));
+                });
                 state.counters["substeps"] = stats.subSteps;
                 state.counters["grow_ms"] = 1e3 * stats.growSeconds;
                 state.counters["sample_ms"] = 1e3 * stats.sampleSeconds;
@@ -92,14 +88,10 @@ void registerAdvectBenchmarks() {
             "advect/" + item + "/openvdb_LevelSetAdvection",
             [div, h](benchmark::State& state) {
                 const GridPtr start = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3.0);
-                GridPtr g;
-                for (auto _ : state) {
-                    state.PauseTiming();
-                    g = start->deepCopy();
-                    state.ResumeTiming();
-                    openvdb::tools::LevelSetAdvection<Grid, PullField> advection(*g, PullField());
+                const GridPtr g = timedOnCopies(state, *start, [](Grid& grid) {
+                    openvdb::tools::LevelSetAdvection<Grid, PullField> advection(grid, PullField());
                     advection.advect(0.0, 1.0);
-                }
+                });
                 results("openvdb")[div] = g;
                 compare(state, div, "sweepers", *g);
             },

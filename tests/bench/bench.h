@@ -44,6 +44,16 @@ TriangleMesh toTriangleMesh(const VdbMesh& mesh);
 // Triangles and whether every edge has exactly two of them, consistently oriented.
 void addMeshCounters(benchmark::State& state, const TriangleMesh& mesh);
 
+// The unit sphere at voxel size 1/div after one large pull (a ball of radius 0.4, falloff
+// 0.5, moved from (0, 0, 0.9) to (0.3, 0.2, 1.5)), renormalized or not; `touched` gets the
+// box the engine renormalizes after it.
+GridPtr afterLargeStroke(int div, bool renormalize, openvdb::CoordBBox* touched = nullptr);
+
+// Times `run` on a fresh copy of `start` in every iteration (the copy is not timed) and
+// returns the last result.
+GridPtr timedOnCopies(benchmark::State& state, const Grid& start,
+                      const std::function<void(Grid&)>& run);
+
 // Registration, one function per group (called by main in this order).
 void registerDragBenchmarks();
 void registerAdvectBenchmarks();

@@ -17,7 +17,10 @@
 #include <openvdb/tools/VolumeToMesh.h>
 
 #include "bench.h"
+#include "deform/sweep.h"
+#include "levelset/advect.h"
 #include "levelset/level_set.h"
+#include "tools/ellipsoid.h"
 
 namespace sweepers::bench {
 
@@ -116,6 +119,31 @@ void addMeshCounters(benchmark::State& state, const TriangleMesh& mesh) {
     state.counters["watertight"] = topo.watertight() ? 1.0 : 0.0;
     state.counters["oriented"] = topo.consistentlyOriented() ? 1.0 : 0.0;
     state.counters["euler"] = double(topo.eulerCharacteristic());
+}
+
+GridPtr afterLargeStroke(int div, bool renormalize, openvdb::CoordBBox* touched) {
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, 1.0 / div, 3.0);
+    Placement a, b;
+    a.t = {0, 0, 0.9};
+    b.t = {0.3, 0.2, 1.5};
+    const Sweep sweep{{{std::make_shared<EllipsoidShape>(0.4), 0.5, {a, b}}}};
+    AdvectOptions options;
+    options.renormalize = renormalize;
+    const AdvectStats stats = advectSegment(*g, SweepSegment(sweep, 0), options);
+    if (touched) *touched = stats.touched;
+    return g;
+}
+
+GridPtr timedOnCopies(benchmark::State& state, const Grid& start,
+                      const std::function<void(Grid&)>& run) {
+    GridPtr g;
+    for (auto _ : state) {
+        state.PauseTiming();
+        g = start.deepCopy();
+        state.ResumeTiming();
+        run(*g);
+    }
+    return g;
 }
 
 benchmark::internal::Benchmark* add(const std::string& name,

@@ -1,24 +1,11 @@
 // Meshing: our marching cubes (every leaf, welded into one mesh, as for export) against
 // tools::volumeToMesh (dual contouring without adaptivity), on the same grids.
 #include "bench.h"
-#include "deform/sweep.h"
-#include "levelset/advect.h"
 #include "levelset/level_set.h"
 #include "mesh/marching_cubes.h"
-#include "tools/ellipsoid.h"
 
 namespace sweepers::bench {
 namespace {
-
-GridPtr strokeResult(int div) {
-    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, 1.0 / div, 3.0);
-    Placement a, b;
-    a.t = {0, 0, 0.9};
-    b.t = {0.3, 0.2, 1.5};
-    const Sweep sweep{{{std::make_shared<EllipsoidShape>(0.4), 0.5, {a, b}}}};
-    advectSegment(*g, SweepSegment(sweep, 0));
-    return g;
-}
 
 void registerGrid(const std::string& item, std::function<GridPtr()> make) {
     auto shared = std::make_shared<GridPtr>();
@@ -54,7 +41,8 @@ void registerMeshBenchmarks() {
     for (const int div : voxelDivisions()) {
         registerGrid("sphere_h" + std::to_string(div),
                      [div] { return makeSphere(Eigen::Vector3d::Zero(), 1.0, 1.0 / div, 3.0); });
-        registerGrid("stroke_h" + std::to_string(div), [div] { return strokeResult(div); });
+        registerGrid("stroke_h" + std::to_string(div),
+                     [div] { return afterLargeStroke(div, true); });
     }
 }
 

@@ -7,17 +7,15 @@
 // (b) the unit sphere right after a large pull advected without renormalization, errors
 //     against the exact distance to its zero-crossing mesh (meshToLevelSet of our
 //     marching-cubes mesh of that grid: the interface all methods must keep).
+#include <optional>
+
 #include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/LevelSetTracker.h>
-#include <openvdb/tools/MeshToVolume.h>
 
 #include "bench.h"
-#include "deform/sweep.h"
-#include "levelset/advect.h"
 #include "levelset/fast_marching.h"
 #include "levelset/level_set.h"
 #include "mesh/marching_cubes.h"
-#include "tools/ellipsoid.h"
 
 namespace sweepers::bench {
 namespace {
@@ -60,29 +58,16 @@ Case torusCase(int div) {
 
 Case strokeCase(int div) {
     const double h = 1.0 / div;
-    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3.0);
-    Placement a, b;
-    a.t = {0, 0, 0.9};
-    b.t = {0.3, 0.2, 1.5};
-    const Sweep sweep{{{std::make_shared<EllipsoidShape>(0.4), 0.5, {a, b}}}};
-    AdvectOptions options;
-    options.renormalize = false;
-    const AdvectStats stats = advectSegment(*g, SweepSegment(sweep, 0), options);
+    openvdb::CoordBBox touched;
+    const GridPtr g = afterLargeStroke(div, false, &touched);
     // The reference: exact distances to the interface the grid holds now.
     const TriangleMesh mesh = meshLevelSet(*g);
-    std::vector<openvdb::Vec3s> points;
-    for (const auto& p : mesh.positions)
-        points.emplace_back(p.x(), p.y(), p.z());
-    std::vector<openvdb::Vec3I> tris;
-    for (const auto& t : mesh.triangles)
-        tris.emplace_back(t[0], t[1], t[2]);
-    const GridPtr reference =
-        openvdb::tools::meshToLevelSet<Grid>(g->transform(), points, tris, 6.0f);
+    const GridPtr reference = levelSetFromMesh(mesh.positions, mesh.triangles, h, 6.0);
     Sdf exact = [reference](const Eigen::Vector3d& p) {
         return double(
             reference->tree().getValue(reference->transform().worldToIndexCellCentered(toVdb(p))));
     };
-    return {"stroke_h" + std::to_string(div), g, exact, stats.touched};
+    return {"stroke_h" + std::to_string(div), g, exact, touched};
 }
 
 void report(benchmark::State& state, const Grid& result, const Case& c) {
@@ -105,16 +90,12 @@ void registerCase(const std::string& item, std::function<Case()> make) {
     auto fmm = [get](FmmOrder order, bool local) {
         return [get, order, local](benchmark::State& state) {
             const Case& c = get();
-            GridPtr g;
-            for (auto _ : state) {
-                state.PauseTiming();
-                g = c.grid->deepCopy();
-                state.ResumeTiming();
+            const GridPtr g = timedOnCopies(state, *c.grid, [&](Grid& grid) {
                 if (local)
-                    renormalize(*g, c.local, order);
+                    renormalize(grid, c.local, order);
                 else
-                    renormalizeAll(*g, order);
-            }
+                    renormalizeAll(grid, order);
+            });
             report(state, *g, c);
         };
     };
@@ -136,14 +117,10 @@ void registerCase(const std::string& item, std::function<Case()> make) {
         base + "openvdb_LevelSetTracker_normalize",
         [get](benchmark::State& state) {
             const Case& c = get();
-            GridPtr g;
-            for (auto _ : state) {
-                state.PauseTiming();
-                g = c.grid->deepCopy();
-                state.ResumeTiming();
-                openvdb::tools::LevelSetTracker<Grid> tracker(*g);
+            const GridPtr g = timedOnCopies(state, *c.grid, [](Grid& grid) {
+                openvdb::tools::LevelSetTracker<Grid> tracker(grid);
                 tracker.normalize();
-            }
+            });
             report(state, *g, c);
         },
         3);
