@@ -4,29 +4,29 @@
 #include <filesystem>
 #include <stdexcept>
 
-#include "deform/step_deformation.h"
-#include "deform/sweep.h"
+#include "io/atomic_file.h"
 #include "io/mesh_file.h"
+#include "io/start_grid.h"
 #include "io/vdb_file.h"
-#include "levelset/advect.h"
 #include "levelset/level_set.h"
 
 namespace sweepers {
 
 Document::Document(StrokeScript script, const std::string& scriptDir, const Progress& progress,
-                   GridPtr start)
-    : script_(std::move(script)), scriptDir_(scriptDir), grid_(std::move(start)) {
-    RunOptions options;
-    if (!grid_) grid_ = makeStartGrid(script_, scriptDir_, options);
+                   GridPtr start, Interrupter* interrupter)
+    : script_(std::move(script)), scriptDir_(scriptDir),
+      sculptor_(start ? std::move(start) : makeStartGrid(script_, scriptDir_, 0.0, interrupter)) {
+    const double h = sculptor_.grid().voxelSize()[0];
     if (script_.start.kind == StartShape::Kind::Vdb &&
-        std::abs(grid_->voxelSize()[0] - script_.grid.voxelSize) > 1e-9 * script_.grid.voxelSize)
+        std::abs(h - script_.grid.voxelSize) > 1e-9 * script_.grid.voxelSize)
         throw std::runtime_error(
-            "the document starts from a VDB file at voxel size " +
-            std::to_string(grid_->voxelSize()[0]) +
+            "the document starts from a VDB file at voxel size " + std::to_string(h) +
             "; it cannot be replayed at another voxel size (start from a sphere or a mesh)");
-    applyStrokes(*grid_, script_, options, progress);
-    markAsDocument(*grid_);
-    mesher_.rebuild(*grid_);
+    sculptor_.setInterrupter(interrupter);
+    applyStrokes(sculptor_, script_.strokes, progress);
+    markAsDocument(sculptor_.grid());
+    sculptor_.startMeshing();
+    sculptor_.setInterrupter(nullptr);
 }
 
 StrokeScript Document::sphereScript(double voxelSize) {
@@ -38,15 +38,17 @@ StrokeScript Document::sphereScript(double voxelSize) {
     return s;
 }
 
-Document Document::open(const std::string& path, double meshVoxelSize, const Progress& progress) {
+Document Document::open(const std::string& path, double meshVoxelSize, const Progress& progress,
+                        Interrupter* interrupter) {
     const bool isScript = path.size() >= 5 && path.compare(path.size() - 5, 5, ".json") == 0;
-    if (isScript) return Document(readStrokeScript(path), directoryOf(path), progress);
+    if (isScript)
+        return Document(readStrokeScript(path), directoryOf(path), progress, nullptr, interrupter);
     if (isMeshPath(path)) {
         // A mesh becomes the start of a new script, at the given voxel size.
         StrokeScript s = sphereScript(meshVoxelSize);
         s.start.kind = StartShape::Kind::Mesh;
         s.start.file = std::filesystem::absolute(path).string();
-        return Document(s, directoryOf(s.start.file), progress);
+        return Document(s, directoryOf(s.start.file), progress, nullptr, interrupter);
     }
     // A VDB: read once (a clear error for anything but a float level set); it is the start
     // of a new script.
@@ -57,7 +59,7 @@ Document Document::open(const std::string& path, double meshVoxelSize, const Pro
     s.start.kind = StartShape::Kind::Vdb;
     s.start.file = std::filesystem::absolute(path).string();
     const std::string dir = directoryOf(s.start.file);
-    return Document(std::move(s), dir, {}, std::move(g));
+    return Document(std::move(s), dir, {}, std::move(g), interrupter);
 }
 
 void Document::beginStroke(const ToolSpec& tool, MirrorAxis mirror) {
@@ -70,24 +72,24 @@ void Document::beginStroke(const ToolSpec& tool, MirrorAxis mirror) {
 void Document::beginEdit() {
     endEdit();
     applied_.clear();
-    before_ = LeafSnapshot();
+    sculptor_.startRecording();
     inEdit_ = true;
 }
 
-// One deformation, exactly as applyStrokes does it (so the recorded script replays to the
-// same grid), after saving the blocks it may change.
-SegmentReport Document::advect(const StepDeformation& deformation) {
-    before_.capture(*grid_, changedRegion(*grid_, deformation));
-    SegmentReport r;
-    r.stroke = script_.strokes.size() + applied_.size();
-    const auto t0 = std::chrono::steady_clock::now();
-    r.stats = advectSegment(*grid_, deformation);
-    const auto t1 = std::chrono::steady_clock::now();
-    r.seconds = std::chrono::duration<double>(t1 - t0).count();
-    r.remeshedLeaves = mesher_.update(*grid_, r.stats.touched);
-    r.meshSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
-    modified_ = true;
-    return r;
+template <typename Work> SegmentReport Document::cancellable(const Work& work) {
+    try {
+        SegmentReport r = work();
+        r.stroke = script_.strokes.size() + applied_.size();
+        modified_ = true;
+        return r;
+    } catch (const Cancelled&) {
+        // The segment stopped half-way: the grid goes back to where the edit began.
+        sculptor_.restoreRecording();
+        sculptor_.stopRecording();
+        applied_.clear();
+        inEdit_ = inStroke_ = false;
+        throw;
+    }
 }
 
 SegmentReport Document::extendStroke(const Placement& next) {
@@ -96,7 +98,7 @@ SegmentReport Document::extendStroke(const Placement& next) {
     trial.tools[0].path.push_back(next);
     const Sweep sweep = toSweep(trial); // throws for a motion without a logarithm
     const std::size_t k = sweep.segmentCount() - 1;
-    SegmentReport r = advect(SweepSegment(sweep, k));
+    SegmentReport r = cancellable([&] { return sculptor_.applySegment(SweepSegment(sweep, k)); });
     r.segment = k;
     current_ = std::move(trial);
     return r;
@@ -104,12 +106,7 @@ SegmentReport Document::extendStroke(const Placement& next) {
 
 SegmentReport Document::applyStroke(const Stroke& stroke) {
     if (!inEdit_ || inStroke_) throw std::logic_error("applyStroke outside an edit");
-    SegmentReport last;
-    const auto parts = planStroke(*grid_, stroke);
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-        last = advect(*parts[k]);
-        last.segment = k;
-    }
+    SegmentReport last = cancellable([&] { return sculptor_.applyStroke(stroke); });
     applied_.push_back(stroke);
     return last;
 }
@@ -119,11 +116,11 @@ void Document::endEdit() {
     // A click without a drag changes nothing and is not kept.
     if (inStroke_ && current_.tools[0].path.size() >= 2) applied_.push_back(current_);
     inEdit_ = inStroke_ = false;
+    LeafSnapshot before = sculptor_.stopRecording();
     if (applied_.empty()) return;
     script_.strokes.insert(script_.strokes.end(), applied_.begin(), applied_.end());
-    undo_.push_back({std::move(applied_), std::move(before_)});
+    undo_.push_back({std::move(applied_), std::move(before)});
     applied_.clear();
-    before_ = LeafSnapshot();
     redo_.clear();
     trimToBudget();
 }
@@ -131,9 +128,10 @@ void Document::endEdit() {
 // Puts an edit's snapshot back and returns the same edit holding the blocks as they were
 // just before (so undo gives what redo needs, and the other way round).
 Document::Edit Document::swapIn(Edit e) {
-    LeafSnapshot current = LeafSnapshot::sameBlocks(*grid_, e.snapshot);
-    e.snapshot.restore(*grid_);
-    mesher_.update(*grid_, e.snapshot.bounds());
+    Grid& grid = sculptor_.grid();
+    LeafSnapshot current = LeafSnapshot::sameBlocks(grid, e.snapshot);
+    e.snapshot.restore(grid);
+    sculptor_.mesher().update(grid, e.snapshot.bounds());
     modified_ = true;
     return {std::move(e.strokes), std::move(current)};
 }
@@ -178,7 +176,7 @@ void Document::trimToBudget() {
 }
 
 void Document::saveVdb(const std::string& path) {
-    writeLevelSet(*grid_, path);
+    writeLevelSet(sculptor_.grid(), path);
 }
 
 void Document::saveScript(const std::string& path) {
@@ -191,11 +189,11 @@ void Document::saveScript(const std::string& path) {
 }
 
 Document Document::replayAt(StrokeScript script, const std::string& scriptDir, double voxelSize,
-                            const Progress& progress) {
+                            const Progress& progress, Interrupter* interrupter) {
     if (!(voxelSize > 0.0) || !std::isfinite(voxelSize))
         throw std::runtime_error("the voxel size must be a positive number");
     script.grid.voxelSize = voxelSize;
-    return Document(std::move(script), scriptDir, progress);
+    return Document(std::move(script), scriptDir, progress, nullptr, interrupter);
 }
 
 } // namespace sweepers

@@ -1,15 +1,18 @@
 // The modeler's document: a level set, its mesh kept up to date leaf by leaf, every edit
 // recorded as a stroke script (which `sweepers-cli apply` replays to the same grid), and
-// undo / redo that keep only the blocks a stroke touched. No GL here.
+// undo / redo that keep only the blocks a stroke touched. No GL here. Every segment goes
+// through the Sculptor's applySegment, as `sweepers-cli apply` does.
+//
+// Long work can be cancelled through an interrupter: opening, importing and resampling
+// (a new document is simply not made) and sculpting (a cancelled segment puts back the
+// whole edit in progress and throws Cancelled).
 #pragma once
 
 #include <deque>
 #include <string>
 
-#include "io/script_runner.h"
 #include "io/stroke_script.h"
-#include "levelset/leaf_snapshot.h"
-#include "mesh/marching_cubes.h"
+#include "sculpt/sculptor.h"
 
 namespace sweepers {
 
@@ -18,19 +21,22 @@ class Document {
     // Builds the script's start shape and applies its strokes (they become the document's
     // history, not undoable). Throws on bad input, leaving nothing half made.
     Document(StrokeScript script, const std::string& scriptDir, const Progress& progress = {},
-             GridPtr start = nullptr); // start: the script's start shape, when already made
+             GridPtr start = nullptr, // start: the script's start shape, when already made
+             Interrupter* interrupter = nullptr);
     // A unit sphere at voxel size h.
     static StrokeScript sphereScript(double voxelSize);
     // Opens a .vdb (a float level set), a .json stroke script, or imports a mesh
     // (.obj, .ply, .stl) at `meshVoxelSize`.
     static Document open(const std::string& path, double meshVoxelSize = 1.0 / 64,
-                         const Progress& progress = {});
+                         const Progress& progress = {}, Interrupter* interrupter = nullptr);
     // A history replayed at another voxel size (a resolution change).
     static Document replayAt(StrokeScript script, const std::string& scriptDir, double voxelSize,
-                             const Progress& progress = {});
+                             const Progress& progress = {}, Interrupter* interrupter = nullptr);
 
-    const Grid& grid() const { return *grid_; }
-    const SurfaceMesher& mesher() const { return mesher_; }
+    const Grid& grid() const { return sculptor_.grid(); }
+    const SurfaceMesher& mesher() const { return sculptor_.mesher(); }
+    // Polled while sculpting; may be changed between edits.
+    void setInterrupter(Interrupter* interrupter) { sculptor_.setInterrupter(interrupter); }
     const StrokeScript& script() const { return script_; }
     const std::string& scriptDir() const { return scriptDir_; }
 
@@ -64,28 +70,27 @@ class Document {
     void markModified() { modified_ = true; }
 
     // What changed in the mesh since the last call (for re-upload).
-    MeshChanges takeMeshChanges() { return mesher_.takeChanges(); }
+    MeshChanges takeMeshChanges() { return sculptor_.mesher().takeChanges(); }
 
   private:
     struct Edit {
         std::vector<Stroke> strokes;
         LeafSnapshot snapshot; // undo stack: before the strokes; redo stack: after them
     };
-    SegmentReport advect(const StepDeformation& deformation);
+    // Runs sculpting work; a cancelled one puts back the edit in progress and rethrows.
+    template <typename Work> SegmentReport cancellable(const Work& work);
     Edit swapIn(Edit e);
     void trimToBudget();
 
     StrokeScript script_;
     std::string scriptDir_;
-    GridPtr grid_;
-    SurfaceMesher mesher_;
+    Sculptor sculptor_;
     std::deque<Edit> undo_;
     std::vector<Edit> redo_;
     std::size_t budget_ = std::size_t(512) << 20;
     bool inEdit_ = false, inStroke_ = false, modified_ = false;
     SweepStroke current_;
     std::vector<Stroke> applied_; // strokes of the edit in progress
-    LeafSnapshot before_;
 };
 
 } // namespace sweepers

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
     std::string script, size;
     int threads = 0;
     CLI::App app{"Sweepers: sculpt a level set with swept space deformations"};
+    app.set_version_flag("--version", "sweepers " SWEEPERS_VERSION);
     app.add_option("file", o.open, "a .vdb level set or a stroke script (.json) to open");
     app.add_option("--script", script, "a stroke script to open (same as giving it as file)");
     app.add_option("--voxel-size", o.voxelSize, "voxel size of a new sphere")
@@ -31,6 +32,8 @@ int main(int argc, char** argv) {
     app.add_flag("--hide-ui", o.hideUi, "draw no panels");
     app.add_flag("--latency-report", o.latencyReport,
                  "print stroke latency (drag event to mesh on screen) by stage at exit");
+    app.add_option("--latency-csv", o.latencyCsv,
+                   "write every segment's latency by stage (ms) to this CSV at exit");
     app.add_option("--threads", threads, "worker threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
     CLI11_PARSE(app, argc, argv);

@@ -16,6 +16,7 @@ struct ModelerOptions {
     std::string saveScript;     // the recorded stroke script, written when the window closes
     bool hideUi = false;        // no panels (clean screenshots)
     bool latencyReport = false; // print per-segment latency by stage when the window closes
+    std::string latencyCsv;     // ... and write every segment's figures here (ms)
     std::string argv0;
 };
 

@@ -1,5 +1,6 @@
 // sweepers-cli: the command-line front end. Every failure prints one line on stderr,
 // exits non-zero and leaves no output file behind.
+#include <csignal>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -11,18 +12,27 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include "io/atomic_file.h"
 #include "io/mesh_file.h"
-#include "io/script_runner.h"
+#include "io/start_grid.h"
 #include "io/stroke_script.h"
 #include "io/vdb_file.h"
 #include "levelset/level_set.h"
 #include "levelset/measure.h"
 #include "mesh/marching_cubes.h"
+#include "sculpt/sculptor.h"
 
 namespace {
 
 using namespace sweepers;
 using nlohmann::json;
+
+// Ctrl-C (SIGINT) or SIGTERM stops long work at the next leaf range: the handler only sets
+// a flag, the engine throws Cancelled, and no output has been written yet.
+FlagInterrupter gStop;
+extern "C" void onStopSignal(int) {
+    gStop.interrupt();
+}
 
 json vec(const Eigen::Vector3d& v) {
     return json::array({v.x(), v.y(), v.z()});
@@ -150,29 +160,30 @@ int runApply(const ApplyArgs& a) {
     const StrokeScript script = readStrokeScript(a.script);
     if (a.voxelSize != 0.0 && !(a.voxelSize > 0.0 && std::isfinite(a.voxelSize)))
         throw std::runtime_error("--voxel-size must be a positive number");
-    if (!a.mesh.empty() && !isMeshPath(a.mesh))
-        throw std::runtime_error(a.mesh + ": unknown mesh format (use .obj, .ply or .stl)");
+    if (!a.mesh.empty()) requireMeshPath(a.mesh);
     requireWritable(a.output);
     if (!a.mesh.empty()) requireWritable(a.mesh);
 
-    RunOptions options;
-    options.voxelSize = a.voxelSize;
-    options.advect.resampleEachSubStep = a.perSubStep;
-    options.advect.renormalization = a.firstOrder ? FmmOrder::First : FmmOrder::Second;
-    options.remesh = a.stats;
-    options.advect.sampling = a.cubic ? Sampling::MonotoneCubic : Sampling::Trilinear;
-    const GridPtr grid = makeStartGrid(script, directoryOf(a.script), options);
-    const double before = measureLevelSet(*grid).volume;
-    const TriangleMesh startMesh = a.stats ? meshLevelSet(*grid) : TriangleMesh{};
+    AdvectOptions options;
+    options.resampleEachSubStep = a.perSubStep;
+    options.renormalization = a.firstOrder ? FmmOrder::First : FmmOrder::Second;
+    options.sampling = a.cubic ? Sampling::MonotoneCubic : Sampling::Trilinear;
+    options.interrupter = &gStop;
+    Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop), options);
+    const Grid& grid = sculptor.grid();
+    const double before = measureLevelSet(grid).volume;
+    if (a.stats) sculptor.startMeshing();
+    const double meshBefore = a.stats ? sculptor.mesher().enclosedVolume() : 0.0;
     const auto reports =
-        applyStrokes(*grid, script, options, [&](std::size_t done, std::size_t all) {
+        applyStrokes(sculptor, script.strokes, [&](std::size_t done, std::size_t all) {
             if (!a.quiet)
                 std::fprintf(stderr, "\rapplying %s: segment %zu / %zu", a.script.c_str(), done,
                              all);
         });
     if (!a.quiet && !reports.empty()) std::fprintf(stderr, "\n");
+    pollInterrupt(&gStop);
     if (a.stats) {
-        std::fprintf(stderr, "mesh volume before: %.7f\n", enclosedVolume(startMesh));
+        std::fprintf(stderr, "mesh volume before: %.7f\n", meshBefore);
         std::fprintf(stderr, "stroke segment steps interface widened  grow_ms sample_ms renorm_ms "
                              "mesh_ms leaves mesh_volume\n");
         for (const auto& r : reports)
@@ -188,15 +199,15 @@ int runApply(const ApplyArgs& a) {
         ren += r.stats.renormalizeSeconds;
         grow += r.stats.growSeconds;
     }
-    writeLevelSet(*grid, a.output);
-    const double after = measureLevelSet(*grid).volume;
+    writeLevelSet(grid, a.output);
+    const double after = measureLevelSet(grid).volume;
     if (!a.quiet)
         std::fprintf(stderr,
                      "wrote %s: %zu segments (band growth %.3f s, sampling %.3f s, "
                      "renormalization %.3f s), volume %.6g -> %.6g (%+.3f%%)\n",
                      a.output.c_str(), reports.size(), grow, adv, ren, before, after,
                      100.0 * (after - before) / before);
-    if (!a.mesh.empty()) exportMesh(*grid, a.mesh);
+    if (!a.mesh.empty()) exportMesh(grid, a.mesh);
     return 0;
 }
 
@@ -204,6 +215,7 @@ int runApply(const ApplyArgs& a) {
 
 int main(int argc, char** argv) {
     CLI::App app{"sweepers-cli: sculpt narrow-band level sets with sweepers"};
+    app.set_version_flag("--version", "sweepers-cli " SWEEPERS_VERSION);
     app.require_subcommand(1);
     int threads = 0;
     app.add_option("--threads", threads, "Worker threads (default: all cores)")
@@ -256,6 +268,8 @@ int main(int argc, char** argv) {
     } catch (const CLI::ParseError& e) {
         return app.exit(e);
     }
+    std::signal(SIGINT, onStopSignal);
+    std::signal(SIGTERM, onStopSignal);
     std::unique_ptr<tbb::global_control> limit;
     if (threads > 0)
         limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
@@ -276,12 +290,14 @@ int main(int argc, char** argv) {
             return 0;
         }
         if (*mesh) {
-            if (!isMeshPath(output))
-                throw std::runtime_error(output + ": unknown mesh format (use .obj, .ply or .stl)");
+            requireMeshPath(output);
             requireWritable(output);
             exportMesh(*readLevelSet(path), output);
             return 0;
         }
+    } catch (const Cancelled&) {
+        std::cerr << "sweepers-cli: interrupted; nothing was written\n";
+        return 130; // the shell's code for a command ended by SIGINT
     } catch (const std::exception& e) {
         std::cerr << "sweepers-cli: " << e.what() << "\n";
         return 1;

@@ -10,13 +10,13 @@
 
 namespace sweepers {
 
-namespace {
-
 std::string directoryOf(const std::string& path) {
     const auto slash = path.find_last_of('/');
     if (slash == std::string::npos) return ".";
     return slash == 0 ? "/" : path.substr(0, slash);
 }
+
+namespace {
 
 std::string systemError(const std::string& what, const std::string& path) {
     return path + ": " + what + ": " + std::strerror(errno);

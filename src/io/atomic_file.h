@@ -16,4 +16,7 @@ void writeFileAtomically(const std::string& path,
 // Convenience for text content.
 void writeTextAtomically(const std::string& path, const std::string& text);
 
+// The directory part of a path ("." when there is none).
+std::string directoryOf(const std::string& path);
+
 } // namespace sweepers

@@ -37,9 +37,13 @@ bool isMeshPath(const std::string& path) {
     return exportFormat(extension(path)) != nullptr;
 }
 
+void requireMeshPath(const std::string& path) {
+    if (!isMeshPath(path)) throw FileError(path + ": unknown mesh format (use .obj, .ply or .stl)");
+}
+
 void writeMesh(const TriangleMesh& mesh, const std::string& path) {
+    requireMeshPath(path);
     const char* format = exportFormat(extension(path));
-    if (!format) throw FileError(path + ": unknown mesh format (use .obj, .ply or .stl)");
 
     // A one-mesh scene; the aiScene destructor frees everything it points to.
     auto scene = std::make_unique<aiScene>();

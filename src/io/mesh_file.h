@@ -16,5 +16,7 @@ TriangleMesh readMesh(const std::string& path);
 
 // True when the extension names a format writeMesh knows (.obj, .ply, .stl).
 bool isMeshPath(const std::string& path);
+// Throws FileError naming the formats when it does not.
+void requireMeshPath(const std::string& path);
 
 } // namespace sweepers

@@ -8,7 +8,6 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
-#include "tools/ellipsoid.h"
 
 namespace sweepers {
 
@@ -107,16 +106,18 @@ Placement readPlacement(const Reader& r, const json& v, const std::string& at) {
 ToolSpec readTool(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, {"shape", "size", "falloff", "path"});
     ToolSpec t;
-    t.shape = r.string(r.require(v, at, "shape"), at + "/shape");
+    const std::string shape = r.string(r.require(v, at, "shape"), at + "/shape");
     const json& size = r.require(v, at, "size");
-    if (t.shape == "ball") {
+    if (shape == "ball") {
+        t.shape = ToolShapeKind::Ball;
         t.size = Eigen::Vector3d::Constant(r.positive(size, at + "/size"));
-    } else if (t.shape == "ellipsoid") {
+    } else if (shape == "ellipsoid") {
+        t.shape = ToolShapeKind::Ellipsoid;
         t.size = r.vec3(size, at + "/size");
         for (int i = 0; i < 3; ++i)
             if (!(t.size[i] > 0.0)) r.fail(at + "/size/" + std::to_string(i), "must be positive");
     } else {
-        r.fail(at + "/shape", "unknown shape \"" + t.shape + "\" (expected ball or ellipsoid)");
+        r.fail(at + "/shape", "unknown shape \"" + shape + "\" (expected ball or ellipsoid)");
     }
     t.falloff = r.positive(r.require(v, at, "falloff"), at + "/falloff");
     const json& path = r.require(v, at, "path");
@@ -171,8 +172,12 @@ SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
     s.move = r.vec3(r.require(v, at, "move"), at + "/move");
     s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
     if (auto it = v.find("ring"); it != v.end()) {
-        s.ring = r.string(*it, at + "/ring");
-        if (s.ring != "discrete" && s.ring != "convolution")
+        const std::string ring = r.string(*it, at + "/ring");
+        if (ring == "discrete")
+            s.ring = SwirlRing::Discrete;
+        else if (ring == "convolution")
+            s.ring = SwirlRing::Convolution;
+        else
             r.fail(at + "/ring", "expected \"discrete\" or \"convolution\"");
     }
     if (auto it = v.find("swirls"); it != v.end()) {
@@ -355,8 +360,9 @@ std::string formatStrokeScript(const StrokeScript& s) {
             json tools = json::array();
             for (const ToolSpec& t : sw->tools) {
                 json tj;
-                tj["shape"] = t.shape;
-                if (t.shape == "ball")
+                const bool ball = t.shape == ToolShapeKind::Ball;
+                tj["shape"] = ball ? "ball" : "ellipsoid";
+                if (ball)
                     tj["size"] = t.size.x();
                 else
                     tj["size"] = vecJson(t.size);
@@ -373,7 +379,7 @@ std::string formatStrokeScript(const StrokeScript& s) {
             j["at"] = vecJson(sr->at);
             j["move"] = vecJson(sr->move);
             j["radius"] = sr->radius;
-            j["ring"] = sr->ring;
+            j["ring"] = sr->ring == SwirlRing::Convolution ? "convolution" : "discrete";
             j["swirls"] = sr->swirls;
             if (sr->ball > 0.0) j["ball"] = sr->ball;
         } else {
@@ -390,30 +396,6 @@ std::string formatStrokeScript(const StrokeScript& s) {
 
 void writeStrokeScript(const StrokeScript& script, const std::string& path) {
     writeTextAtomically(path, formatStrokeScript(script));
-}
-
-SwirlSpec toSwirl(const SwirlStroke& stroke) {
-    SwirlSpec s;
-    s.at = stroke.at;
-    s.move = stroke.move;
-    s.radius = stroke.radius;
-    s.ring = stroke.ring == "convolution" ? SwirlRing::Convolution : SwirlRing::Discrete;
-    s.swirls = stroke.swirls;
-    return s;
-}
-
-Sweep toSweep(const SweepStroke& stroke) {
-    Sweep sweep;
-    sweep.mirror = stroke.mirror;
-    for (const ToolSpec& t : stroke.tools) {
-        SweptTool st;
-        st.shape = t.shape == "ball" ? std::make_shared<EllipsoidShape>(t.size.x())
-                                     : std::make_shared<EllipsoidShape>(t.size);
-        st.falloff = t.falloff;
-        st.path = t.path;
-        sweep.tools.push_back(std::move(st));
-    }
-    return sweep;
 }
 
 } // namespace sweepers

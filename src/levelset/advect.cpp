@@ -34,7 +34,7 @@ double since(Clock::time_point t) {
 // at a voxel centre returns its value exactly).
 template <typename Map>
 std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& box, const Map& map,
-                     Sampling sampling, openvdb::MaskGrid& changed) {
+                     Sampling sampling, openvdb::MaskGrid& changed, Interrupter* interrupter) {
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> marks;
     openvdb::tree::LeafManager<Grid::TreeType> leaves(grid.tree());
     std::atomic<std::size_t> count{0};
@@ -44,6 +44,7 @@ std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& b
         openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> trilinear(
             acc, source.transform());
         std::size_t n = 0;
+        pollInterrupt(interrupter);
         for (auto leaf = range.begin(); leaf; ++leaf) {
             if (!box.hasOverlap(leaf->getNodeBoundingBox())) continue;
             for (auto it = leaf->beginValueOn(); it; ++it) {
@@ -114,6 +115,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     tbb::enumerable_thread_specific<Marks> marks;
     tbb::enumerable_thread_specific<double> stretch(1.0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
+        pollInterrupt(options.interrupter);
         Marks& m = marks.local();
         double& worst = stretch.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -172,7 +174,8 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         openvdb::tools::dilateActiveValues(widen->tree(), int(std::ceil(needed - halfWidth)),
                                            openvdb::tools::NN_FACE, openvdb::tools::IGNORE_TILES);
         source->tree().topologyUnion(widen->tree());
-        renormalize(*source, indexBox(grid, seg.affectedBox(), int(needed) + 1), FmmOrder::First);
+        renormalize(*source, indexBox(grid, seg.affectedBox(), int(needed) + 1), FmmOrder::First,
+                    options.interrupter);
     }
     // Voxels the band grows into: renormalized (or dropped again) wherever they are.
     openvdb::MaskGrid::Ptr fresh = mask->deepCopy();
@@ -187,14 +190,14 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         if (!source) source = grid.deepCopy();
         stats.sampledVoxels = resample(
             grid, *source, region, [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); },
-            options.sampling, *changed);
+            options.sampling, *changed, options.interrupter);
     } else {
         for (int k = 0; k < seg.steps(); ++k) {
             GridPtr step = (k == 0 && source) ? source : grid.deepCopy();
             stats.sampledVoxels += resample(
                 grid, *step, region,
                 [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling,
-                *changed);
+                *changed, options.interrupter);
         }
     }
     // Voxels inside the region that are not in the band kept their old inactive values,
@@ -214,7 +217,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                                            openvdb::tools::NN_FACE_EDGE_VERTEX,
                                            openvdb::tools::IGNORE_TILES);
         changed->tree().topologyUnion(fresh->tree());
-        renormalize(grid, touched, *changed, options.renormalization);
+        renormalize(grid, touched, *changed, options.renormalization, options.interrupter);
     }
     stats.renormalizeSeconds = since(t0);
     stats.touched = touched;

@@ -19,6 +19,7 @@
 
 #include "deform/step_deformation.h"
 #include "levelset/fast_marching.h"
+#include "levelset/interrupt.h"
 #include "levelset/vdb.h"
 
 namespace sweepers {
@@ -30,6 +31,7 @@ struct AdvectOptions {
     Sampling sampling = Sampling::Trilinear; // or the monotone cubic of appendix C.1
     FmmOrder renormalization = FmmOrder::Second;
     bool renormalize = true;
+    Interrupter* interrupter = nullptr; // polled per leaf range; throws Cancelled
 };
 
 struct AdvectStats {

@@ -127,26 +127,31 @@ float solveUpwind(float m[3], float c[3], int n, float h) {
 
 namespace {
 FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
-                          const openvdb::MaskGrid* only, FmmOrder order);
+                          const openvdb::MaskGrid* only, FmmOrder order, Interrupter* interrupter);
 } // namespace
 
-FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder order) {
-    return renormalizeWhere(grid, region, nullptr, order);
+FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder order,
+                     Interrupter* interrupter) {
+    return renormalizeWhere(grid, region, nullptr, order, interrupter);
 }
 
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid& only,
-                     FmmOrder order) {
-    return renormalizeWhere(grid, region, &only, order);
+                     FmmOrder order, Interrupter* interrupter) {
+    return renormalizeWhere(grid, region, &only, order, interrupter);
 }
 
 namespace {
+// Heap pops between two polls of the interrupter.
+constexpr std::size_t kPollEvery = 1 << 14;
+
 FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
-                          const openvdb::MaskGrid* only, FmmOrder order) {
+                          const openvdb::MaskGrid* only, FmmOrder order, Interrupter* interrupter) {
     FmmStats stats;
     if (region.empty()) return stats;
     const float h = float(grid.voxelSize()[0]);
     const float bg = grid.background();
     const float limit = bg; // march as far as the band reaches
+    pollInterrupt(interrupter);
     Domain b(grid, region, 2, only);
     const std::size_t n = b.size();
     std::vector<float> u(n, kInf);
@@ -249,13 +254,14 @@ FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
 
     for (std::size_t i = 0; i < n; ++i)
         stats.seeds += state[i] == Known;
+    pollInterrupt(interrupter);
 
     // 2. March from every known or fixed voxel, inside and outside at once: a voxel's
     //    update only reads neighbours of its own sign, so the two marches share no data.
     using Item = std::pair<float, std::size_t>;
     auto march = [&](const bool side) {
         std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
-        std::size_t marched = 0;
+        std::size_t marched = 0, pops = 0;
         auto update = [&](std::size_t i) {
             float m[3], c[3];
             int k = 0;
@@ -307,6 +313,7 @@ FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
         while (!heap.empty()) {
             const auto [v, i] = heap.top();
             heap.pop();
+            if (++pops % kPollEvery == 0) pollInterrupt(interrupter);
             if (state[i] != Trial || v != u[i]) continue;
             state[i] = Known;
             ++marched;
@@ -319,6 +326,7 @@ FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
     tbb::parallel_invoke([&] { marchedOutside = march(false); },
                          [&] { marchedInside = march(true); });
     stats.marched = marchedOutside + marchedInside;
+    pollInterrupt(interrupter); // the last chance: nothing has been written yet
 
     // 3. Write back: inside the band active with the new distance, beyond it off. Every
     //    voxel lives in an existing leaf, so leaves are written in parallel.
@@ -340,11 +348,11 @@ FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
 }
 } // namespace
 
-FmmStats renormalizeAll(Grid& grid, FmmOrder order) {
+FmmStats renormalizeAll(Grid& grid, FmmOrder order, Interrupter* interrupter) {
     openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
     if (box.empty()) return {};
     box.expand(2);
-    return renormalize(grid, box, order);
+    return renormalize(grid, box, order, interrupter);
 }
 
 } // namespace sweepers

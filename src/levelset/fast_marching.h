@@ -16,6 +16,7 @@
 // leaves (advection activates it before sampling).
 #pragma once
 
+#include "levelset/interrupt.h"
 #include "levelset/vdb.h"
 
 namespace sweepers {
@@ -29,14 +30,17 @@ struct FmmStats {
 
 // Recomputes the distances of the voxels inside `region` (index space). The result is a
 // valid narrow band of the grid's half-width there; the tree is pruned afterwards.
+// `interrupter` is polled between phases and during the march; a cancelled
+// renormalization throws Cancelled before it writes anything back.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region,
-                     FmmOrder order = FmmOrder::Second);
+                     FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
 // The same, for the voxels of `region` that are also on in `only` (what a deformation
 // changed, grown by the band): the rest keep their values and act as boundary.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid& only,
-                     FmmOrder order = FmmOrder::Second);
+                     FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
 
 // Renormalizes the whole active band.
-FmmStats renormalizeAll(Grid& grid, FmmOrder order = FmmOrder::Second);
+FmmStats renormalizeAll(Grid& grid, FmmOrder order = FmmOrder::Second,
+                        Interrupter* interrupter = nullptr);
 
 } // namespace sweepers

@@ -39,7 +39,7 @@ GridPtr makeSphere(const Eigen::Vector3d& center, double radius, double voxelSiz
 
 GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
                          const std::vector<Eigen::Vector3i>& triangles, double voxelSize,
-                         double halfWidth) {
+                         double halfWidth, Interrupter* interrupter) {
     initVdb();
     const auto xform = documentTransform(voxelSize);
     std::vector<openvdb::Vec3s> points; // world space
@@ -50,7 +50,11 @@ GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
     tris.reserve(triangles.size());
     for (const auto& t : triangles)
         tris.emplace_back(t.x(), t.y(), t.z());
-    GridPtr g = openvdb::tools::meshToLevelSet<Grid>(*xform, points, tris, float(halfWidth));
+    Interrupter never;
+    Interrupter& stop = interrupter ? *interrupter : never;
+    GridPtr g = openvdb::tools::meshToLevelSet<Grid>(stop, *xform, points, tris, float(halfWidth));
+    // OpenVDB returns what it had when interrupted: not a level set to keep.
+    pollInterrupt(interrupter);
     markAsDocument(*g);
     return g;
 }
@@ -58,7 +62,7 @@ GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
 void markAsDocument(Grid& grid) {
     grid.setName("surface");
     grid.setGridClass(openvdb::GRID_LEVEL_SET);
-    grid.insertMeta("creator", openvdb::StringMetadata("sweepers"));
+    grid.insertMeta("creator", openvdb::StringMetadata("sweepers " SWEEPERS_VERSION));
     grid.insertMeta("half_width", openvdb::FloatMetadata(float(halfWidthOf(grid))));
 }
 

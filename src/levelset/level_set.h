@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "core/box.h"
+#include "levelset/interrupt.h"
 #include "levelset/vdb.h"
 
 namespace sweepers {
@@ -23,12 +24,14 @@ openvdb::math::Transform::Ptr documentTransform(double voxelSize);
 GridPtr makeSphere(const Eigen::Vector3d& center, double radius, double voxelSize,
                    double halfWidth);
 
-// Level set of a closed triangle mesh (vertices in world units).
+// Level set of a closed triangle mesh (vertices in world units); throws Cancelled when
+// `interrupter` stops it.
 GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
                          const std::vector<Eigen::Vector3i>& triangles, double voxelSize,
-                         double halfWidth);
+                         double halfWidth, Interrupter* interrupter = nullptr);
 
-// Names the grid "surface" and stamps the metadata of the file contract.
+// Names the grid "surface" and stamps the metadata of the file contract (creator:
+// "sweepers VERSION", half_width).
 void markAsDocument(Grid& grid);
 
 // True when a face neighbour of voxel ijk (value v) lies on the other side of the surface:

@@ -103,10 +103,14 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
 
 } // namespace
 
-void SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins) {
+void SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
+                               Interrupter* interrupter) {
     std::vector<MeshChunk> out(origins.size());
-    tbb::parallel_for(std::size_t(0), origins.size(),
-                      [&](std::size_t i) { out[i] = meshLeaf(grid, origins[i]); });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
+        pollInterrupt(interrupter);
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+            out[i] = meshLeaf(grid, origins[i]);
+    });
     for (std::size_t i = 0; i < origins.size(); ++i) {
         if (out[i].triangles.empty()) continue;
         chunks_[origins[i]] = std::move(out[i]);
@@ -117,13 +121,15 @@ MeshChanges SurfaceMesher::takeChanges() {
     return std::exchange(changes_, MeshChanges{});
 }
 
-void SurfaceMesher::rebuild(const Grid& grid) {
-    changes_.all = true;
-    chunks_.clear();
+void SurfaceMesher::rebuild(const Grid& grid, Interrupter* interrupter) {
     std::vector<openvdb::Coord> origins;
     for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
         origins.push_back(leaf->origin());
-    meshLeaves(grid, origins);
+    // Meshed into a new mesher first: a cancelled rebuild leaves this one as it was.
+    SurfaceMesher fresh;
+    fresh.meshLeaves(grid, origins, interrupter);
+    chunks_ = std::move(fresh.chunks_);
+    changes_.all = true;
 }
 
 std::size_t SurfaceMesher::update(const Grid& grid, const openvdb::CoordBBox& touched) {

@@ -12,6 +12,7 @@
 #include <map>
 #include <vector>
 
+#include "levelset/interrupt.h"
 #include "levelset/vdb.h"
 #include "mesh/triangle_mesh.h"
 
@@ -33,8 +34,8 @@ struct MeshChanges {
 
 class SurfaceMesher {
   public:
-    // Meshes every active leaf.
-    void rebuild(const Grid& grid);
+    // Meshes every active leaf; a cancelled rebuild (Cancelled) changes nothing.
+    void rebuild(const Grid& grid, Interrupter* interrupter = nullptr);
     // Re-meshes the leaves overlapping `touched` grown by one voxel; returns how many.
     std::size_t update(const Grid& grid, const openvdb::CoordBBox& touched);
 
@@ -49,7 +50,8 @@ class SurfaceMesher {
     TriangleMesh weld() const;
 
   private:
-    void meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins);
+    void meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
+                    Interrupter* interrupter = nullptr);
     std::map<openvdb::Coord, MeshChunk> chunks_;
     MeshChanges changes_{true, {}};
 };

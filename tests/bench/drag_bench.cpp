@@ -7,20 +7,12 @@
 #include <algorithm>
 
 #include "bench.h"
-#include "io/script_runner.h"
+#include "core/statistics.h"
+#include "io/start_grid.h"
+#include "io/stroke_script.h"
+#include "sculpt/sculptor.h"
 
 namespace sweepers::bench {
-namespace {
-
-double percentile(std::vector<double> v, double q) {
-    if (v.empty()) return 0.0;
-    std::sort(v.begin(), v.end());
-    const std::size_t i = std::min(v.size() - 1, std::size_t(q * double(v.size() - 1) + 0.5));
-    return v[i];
-}
-
-} // namespace
-
 void registerDragBenchmarks() {
     for (const int div : voxelDivisions()) {
         add(
@@ -28,16 +20,15 @@ void registerDragBenchmarks() {
             [div](benchmark::State& state) {
                 const std::string path = std::string(SWEEPERS_DATA_DIR) + "/drag.json";
                 const StrokeScript script = readStrokeScript(path);
-                RunOptions options;
-                options.voxelSize = 1.0 / div;
-                options.remesh = true;
                 std::vector<SegmentReport> reports;
                 GridPtr grid;
                 for (auto _ : state) {
                     state.PauseTiming();
-                    grid = makeStartGrid(script, SWEEPERS_DATA_DIR, options);
+                    grid = makeStartGrid(script, SWEEPERS_DATA_DIR, 1.0 / div);
+                    Sculptor sculptor(grid);
+                    sculptor.startMeshing();
                     state.ResumeTiming();
-                    reports = applyStrokes(*grid, script, options);
+                    reports = applyStrokes(sculptor, script.strokes);
                 }
                 std::vector<double> total, advect, renorm, mesh;
                 for (const SegmentReport& r : reports) {

@@ -30,4 +30,18 @@ inline double torusSdf(const Eigen::Vector3d& p, double R, double r) {
     return std::hypot(q, p.z()) - r;
 }
 
+// Every voxel of the union of both grids' active boxes (grown by a leaf): same value,
+// same state. 0 when the grids are identical there.
+inline std::size_t differingVoxels(const Grid& a, const Grid& b) {
+    openvdb::CoordBBox box = a.evalActiveVoxelBoundingBox();
+    box.expand(b.evalActiveVoxelBoundingBox());
+    box.expand(8);
+    auto ca = a.getConstAccessor();
+    auto cb = b.getConstAccessor();
+    std::size_t n = 0;
+    for (auto it = box.begin(); it; ++it)
+        n += ca.getValue(*it) != cb.getValue(*it) || ca.isValueOn(*it) != cb.isValueOn(*it);
+    return n;
+}
+
 } // namespace sweepers::test

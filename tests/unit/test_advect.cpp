@@ -6,12 +6,14 @@
 #include <gtest/gtest.h>
 
 #include "deform/inflate.h"
-#include "io/script_runner.h"
+#include "io/start_grid.h"
+#include "io/stroke_script.h"
 #include "levelset/advect.h"
 #include "levelset/level_set.h"
 #include "levelset/measure.h"
 #include "levelset/monotone_cubic.h"
 #include "mesh/marching_cubes.h"
+#include "replay.h"
 #include "tools/ellipsoid.h"
 
 using namespace sweepers;
@@ -133,29 +135,30 @@ TEST(Advect, DataScriptsKeepAValidNarrowBand) {
         if (entry.path().extension() != ".json") continue;
         const std::string name = entry.path().filename().string();
         const StrokeScript script = readStrokeScript(entry.path().string());
-        RunOptions options;
-        GridPtr g = makeStartGrid(script, entry.path().parent_path().string(), options);
-        applyStrokes(*g, script, options, {}, [&](std::size_t stroke) {
-            const BandReport r = checkBand(*g);
-            EXPECT_EQ(r.vdbCheck, "") << name << " stroke " << stroke;
-            EXPECT_GE(r.unitGradientFraction(), 0.95) << name << " stroke " << stroke;
-            EXPECT_EQ(r.beyondBand, 0u) << name << " stroke " << stroke;
-            std::printf("[ band ] %s stroke %zu: %zu active, |grad| in [0.9, 1.1] on %.2f%% of %zu "
-                        "interface voxels\n",
-                        name.c_str(), stroke, r.activeVoxels, 100 * r.unitGradientFraction(),
-                        r.nearInterface);
-        });
+        applyScript(
+            script, entry.path().parent_path().string(), 0.0,
+            [&](std::size_t stroke, const Grid& g) {
+                const BandReport r = checkBand(g);
+                EXPECT_EQ(r.vdbCheck, "") << name << " stroke " << stroke;
+                EXPECT_GE(r.unitGradientFraction(), 0.95) << name << " stroke " << stroke;
+                EXPECT_EQ(r.beyondBand, 0u) << name << " stroke " << stroke;
+                std::printf(
+                    "[ band ] %s stroke %zu: %zu active, |grad| in [0.9, 1.1] on %.2f%% of %zu "
+                    "interface voxels\n",
+                    name.c_str(), stroke, r.activeVoxels, 100 * r.unitGradientFraction(),
+                    r.nearInterface);
+            });
     }
 }
 
 TEST(Advect, PinchOpensAHole) {
     const std::string path = std::string(SWEEPERS_DATA_DIR) + "/pinch.json";
     const StrokeScript script = readStrokeScript(path);
-    RunOptions options;
-    GridPtr g = makeStartGrid(script, SWEEPERS_DATA_DIR, options);
+    Sculptor sculptor(makeStartGrid(script, SWEEPERS_DATA_DIR));
+    const GridPtr g = sculptor.gridPtr();
     EXPECT_EQ(topologicalEulerCharacteristic(*g), 2);
     EXPECT_EQ(meshTopology(meshLevelSet(*g)).eulerCharacteristic(), 2);
-    applyStrokes(*g, script, options);
+    applyStrokes(sculptor, script.strokes);
     const TriangleMesh mesh = meshLevelSet(*g);
     const MeshTopology t = meshTopology(mesh);
     EXPECT_EQ(topologicalEulerCharacteristic(*g), 0);
@@ -173,7 +176,7 @@ TEST(Advect, SwirlsKeepVolumeWhereSweepsDoNot) {
     for (const Stroke& s : swirls.strokes) {
         const auto& sw = std::get<SwirlStroke>(s);
         ToolSpec tool;
-        tool.shape = "ball";
+        tool.shape = ToolShapeKind::Ball;
         tool.size = Eigen::Vector3d::Constant(0.1);
         tool.falloff = sw.radius;
         tool.path = {at(sw.at), at(sw.at + sw.move)};
@@ -182,19 +185,18 @@ TEST(Advect, SwirlsKeepVolumeWhereSweepsDoNot) {
         sweeps.strokes.emplace_back(stroke);
     }
     ASSERT_EQ(swirls.strokes.size(), 50u);
-    RunOptions options;
-    options.voxelSize = 1.0 / 128; // a unit sphere 256 voxels across
-    GridPtr a = makeStartGrid(swirls, SWEEPERS_DATA_DIR, options), b = a->deepCopy();
-    const double v0 = measureLevelSet(*a).volume;
-    applyStrokes(*a, swirls, options);
-    applyStrokes(*b, sweeps, options);
-    const double swirlDrift = (measureLevelSet(*a).volume - v0) / v0;
-    const double sweepDrift = (measureLevelSet(*b).volume - v0) / v0;
-    std::printf("[ volume ] 50 strokes at voxel size %g: swirls %+.3f%%, sweeps %+.3f%%\n",
-                options.voxelSize, 100 * swirlDrift, 100 * sweepDrift);
+    const double h = 1.0 / 128; // a unit sphere 256 voxels across
+    Sculptor a(makeStartGrid(swirls, SWEEPERS_DATA_DIR, h)), b(a.grid().deepCopy());
+    const double v0 = measureLevelSet(a.grid()).volume;
+    applyStrokes(a, swirls.strokes);
+    applyStrokes(b, sweeps.strokes);
+    const double swirlDrift = (measureLevelSet(a.grid()).volume - v0) / v0;
+    const double sweepDrift = (measureLevelSet(b.grid()).volume - v0) / v0;
+    std::printf("[ volume ] 50 strokes at voxel size %g: swirls %+.3f%%, sweeps %+.3f%%\n", h,
+                100 * swirlDrift, 100 * sweepDrift);
     EXPECT_LT(std::abs(swirlDrift), 0.01);
     EXPECT_GT(std::abs(sweepDrift), 10 * std::abs(swirlDrift));
-    EXPECT_EQ(topologicalEulerCharacteristic(*a), 2);
+    EXPECT_EQ(topologicalEulerCharacteristic(a.grid()), 2);
 }
 
 TEST(Advect, InflationAddsTheBallInsideAndKeepsVolumeOutside) {

@@ -3,25 +3,15 @@
 #include <gtest/gtest.h>
 
 #include "app/document.h"
+#include "grids.h"
 #include "io/mesh_file.h"
 #include "levelset/raycast.h"
+#include "replay.h"
 
 using namespace sweepers;
+using sweepers::test::differingVoxels;
 
 namespace {
-
-// Every voxel of the union of both grids' active boxes: same value, same state.
-std::size_t differingVoxels(const Grid& a, const Grid& b) {
-    openvdb::CoordBBox box = a.evalActiveVoxelBoundingBox();
-    box.expand(b.evalActiveVoxelBoundingBox());
-    box.expand(8);
-    auto ca = a.getConstAccessor();
-    auto cb = b.getConstAccessor();
-    std::size_t n = 0;
-    for (auto it = box.begin(); it; ++it)
-        n += ca.getValue(*it) != cb.getValue(*it) || ca.isValueOn(*it) != cb.isValueOn(*it);
-    return n;
-}
 
 ToolSpec ballAt(const Eigen::Vector3d& p) {
     ToolSpec t;
@@ -125,9 +115,7 @@ TEST(Document, RecordedScriptReplaysToTheSameGrid) {
     doc.redo();
     EXPECT_EQ(doc.script().strokes.size(), 6u);
     const StrokeScript replayed = parseStrokeScript(formatStrokeScript(doc.script()), "recorded");
-    RunOptions options;
-    GridPtr g = makeStartGrid(replayed, ".", options);
-    applyStrokes(*g, replayed, options);
+    const GridPtr g = applyScript(replayed, ".");
     EXPECT_EQ(differingVoxels(*g, doc.grid()), 0u);
 }
 
@@ -154,10 +142,7 @@ TEST(Document, ImportsAMeshAndReplaysItsHistoryAtAnotherVoxelSize) {
     const Document fine = Document::replayAt(sphere.script(), ".", 1.0 / 48);
     EXPECT_DOUBLE_EQ(fine.grid().voxelSize()[0], 1.0 / 48);
     EXPECT_EQ(fine.script().strokes.size(), 1u);
-    RunOptions options;
-    options.voxelSize = 1.0 / 48;
-    GridPtr g = makeStartGrid(sphere.script(), ".", options);
-    applyStrokes(*g, sphere.script(), options);
+    const GridPtr g = applyScript(sphere.script(), ".", 1.0 / 48);
     EXPECT_EQ(differingVoxels(*g, fine.grid()), 0u);
 }
 

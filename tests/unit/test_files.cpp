@@ -63,7 +63,7 @@ TEST(VdbFile, RoundTripIsBitExact) {
     for (auto it = back->cbeginValueAll(); it; ++it)
         differ += acc.getValue(it.getCoord()) != *it;
     EXPECT_EQ(differ, 0u);
-    EXPECT_EQ(back->metaValue<std::string>("creator"), "sweepers");
+    EXPECT_EQ(back->metaValue<std::string>("creator"), "sweepers " SWEEPERS_VERSION);
     EXPECT_FLOAT_EQ(back->metaValue<float>("half_width"), 3.0f);
 }
 

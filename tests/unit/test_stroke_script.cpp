@@ -60,17 +60,17 @@ TEST(StrokeScript, EveryFieldRoundTrips) {
     const auto& sweep = std::get<SweepStroke>(a.strokes[0]);
     EXPECT_EQ(sweep.mirror, MirrorAxis::X);
     ASSERT_EQ(sweep.tools.size(), 2u);
-    EXPECT_EQ(sweep.tools[0].shape, "ball");
+    EXPECT_EQ(sweep.tools[0].shape, ToolShapeKind::Ball);
     EXPECT_EQ(sweep.tools[0].size, Eigen::Vector3d::Constant(0.3));
     EXPECT_EQ(sweep.tools[0].falloff, 0.25);
     EXPECT_EQ(sweep.tools[0].path[1].angleDegrees, 30.0);
     EXPECT_EQ(sweep.tools[0].path[1].scale, Eigen::Vector3d::Constant(1.2));
     EXPECT_EQ(sweep.tools[0].path[2].scale, Eigen::Vector3d(1.2, 1.3, 1.1));
-    EXPECT_EQ(sweep.tools[1].shape, "ellipsoid");
+    EXPECT_EQ(sweep.tools[1].shape, ToolShapeKind::Ellipsoid);
     EXPECT_EQ(sweep.tools[1].size, Eigen::Vector3d(0.1, 0.2, 0.3));
     EXPECT_EQ(sweep.tools[1].path[2].axis, Eigen::Vector3d(1, 0, 0));
     const auto& swirl = std::get<SwirlStroke>(a.strokes[1]);
-    EXPECT_EQ(swirl.ring, "convolution");
+    EXPECT_EQ(swirl.ring, SwirlRing::Convolution);
     EXPECT_EQ(swirl.swirls, 12);
     EXPECT_EQ(swirl.move, Eigen::Vector3d(0, 0, 0.5));
 

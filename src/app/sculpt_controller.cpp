@@ -1,0 +1,382 @@
+#include "app/sculpt_controller.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+#define GLFW_INCLUDE_NONE // key codes only: this file uses no window
+#include <GLFW/glfw3.h>
+
+#include "levelset/level_set.h"
+#include "levelset/raycast.h"
+
+namespace sweepers {
+
+namespace {
+
+glm::dvec3 toGlm(const Eigen::Vector3d& v) {
+    return {v.x(), v.y(), v.z()};
+}
+Eigen::Vector3d toEigen3(const glm::dvec3& v) {
+    return {v.x, v.y, v.z};
+}
+
+} // namespace
+
+void SculptController::setDocument(Document* doc) {
+    wait();
+    collect();
+    doc_ = doc;
+    drag_ = DragKind::None;
+    pending_ = releasing_ = false;
+    if (doc_) {
+        doc_->setInterrupter(&stop_);
+        volume_ = doc_->mesher().enclosedVolume();
+    }
+}
+
+void SculptController::setViewport(int width, int height) {
+    width_ = std::max(width, 1);
+    height_ = std::max(height, 1);
+}
+
+void SculptController::onButton(int button, bool press, double x, double y, bool shift) {
+    if (!doc_) return;
+    cursorX_ = x;
+    cursorY_ = y;
+    if (!press) {
+        if (drag_ == DragKind::Sculpt) {
+            // The last position counts; the drag ends once its work is done.
+            pending_ = true;
+            releasing_ = true;
+            step();
+        } else {
+            drag_ = DragKind::None;
+        }
+        return;
+    }
+    if (busy() || drag_ == DragKind::Sculpt) return;
+    pressX_ = lastX_ = x;
+    pressY_ = lastY_ = y;
+    if (button == 1 || button == 2 || (button == 0 && shift)) {
+        drag_ = DragKind::Pan;
+        return;
+    }
+    const auto hit = pick(x, y);
+    if (!hit) {
+        drag_ = DragKind::Orbit;
+        return;
+    }
+    grab_ = *hit;
+    axis_ = glm::normalize(camera_.eye() - camera_.target);
+    last_ = placementAt(x, y);
+    drag_ = DragKind::Sculpt;
+    pending_ = false;
+    stop_.reset();
+    if (settings_.mode == SculptMode::Swirl || settings_.mode == SculptMode::Clay) {
+        doc_->beginEdit();
+        if (settings_.mode == SculptMode::Clay) {
+            pendingSince_ = Clock::now();
+            dab(grab_);
+        }
+        return;
+    }
+    ToolSpec tool;
+    tool.shape = ToolShapeKind::Ball;
+    tool.size = Eigen::Vector3d::Constant(settings_.radius);
+    tool.falloff = settings_.falloff;
+    tool.path = {last_};
+    doc_->beginStroke(tool, settings_.mirror);
+}
+
+// Clay mode: one inflation of the tool's radius (2.30) centred half a radius under the
+// surface point p (along the view ray), so that it adds the whole ball (a centre inside
+// the material gives the inserted ball its sign).
+void SculptController::dab(const glm::dvec3& p) {
+    const glm::dvec3 in = p + 0.5 * settings_.radius * glm::normalize(p - camera_.eye());
+    const InflateStroke stroke{toEigen3(in), settings_.radius};
+    Document* doc = doc_;
+    launch([doc, stroke] { return doc->applyStroke(stroke); });
+    lastDab_ = p;
+    dabX_ = cursorX_;
+    dabY_ = cursorY_;
+}
+
+void SculptController::onMove(double x, double y) {
+    const double dx = x - lastX_, dy = y - lastY_;
+    cursorX_ = x;
+    cursorY_ = y;
+    switch (drag_) {
+    case DragKind::Orbit:
+        camera_.orbit(-dx * 0.008, dy * 0.008);
+        break;
+    case DragKind::Pan:
+        camera_.pan(dx / height_, dy / height_);
+        break;
+    case DragKind::Sculpt:
+        // Coalesced: one piece per step, at the latest position; its latency counts from
+        // the first event it absorbs.
+        if (!pending_) pendingSince_ = Clock::now();
+        pending_ = true;
+        break;
+    case DragKind::None:
+        break;
+    }
+    lastX_ = x;
+    lastY_ = y;
+}
+
+void SculptController::onScroll(double dy, bool ctrl) {
+    if (ctrl)
+        settings_.radius = std::clamp(settings_.radius * std::pow(1.1, dy), 0.02, 2.0);
+    else
+        camera_.zoom(std::pow(0.9, dy));
+}
+
+KeyAction SculptController::onKey(int key, bool ctrl, bool shift) {
+    if (!doc_) return KeyAction::None;
+    if (key == GLFW_KEY_ESCAPE) {
+        if (busy()) cancel();
+        return KeyAction::Cancel;
+    }
+    if (ctrl && busy()) return KeyAction::None; // undo and save wait for the sculpting
+    if (ctrl && key == 'Z') {
+        shift ? doc_->redo() : doc_->undo();
+        volume_ = doc_->mesher().enclosedVolume();
+        return KeyAction::None;
+    }
+    if (ctrl && key == 'S') return KeyAction::Save;
+    if (ctrl || (drag_ == DragKind::Sculpt && std::isalpha(key))) return KeyAction::None;
+    double& size = shift ? settings_.falloff : settings_.radius; // [ and ]: shift for falloff
+    switch (key) {
+    case 'G':
+        settings_.mode = SculptMode::Grab;
+        break;
+    case 'T':
+        settings_.mode = SculptMode::Twist;
+        break;
+    case 'S':
+        settings_.mode = SculptMode::Swirl;
+        break;
+    case 'C':
+        settings_.mode = SculptMode::Clay;
+        break;
+    case 'I':
+        settings_.mode = SculptMode::Inflate;
+        break;
+    case 'F':
+        if (!busy()) frameView();
+        break;
+    case 'W':
+        settings_.wireframe = !settings_.wireframe;
+        break;
+    case 'M':
+        settings_.mirror = MirrorAxis((int(settings_.mirror) + 1) % 4);
+        break;
+    case '[':
+        size = std::max(0.02, size / 1.1);
+        break;
+    case ']':
+        size = std::min(2.0, size * 1.1);
+        break;
+    case GLFW_KEY_LEFT:
+        camera_.orbit(-0.1, 0);
+        break;
+    case GLFW_KEY_RIGHT:
+        camera_.orbit(0.1, 0);
+        break;
+    case GLFW_KEY_UP:
+        camera_.orbit(0, 0.1);
+        break;
+    case GLFW_KEY_DOWN:
+        camera_.orbit(0, -0.1);
+        break;
+    case GLFW_KEY_EQUAL:
+        camera_.zoom(0.9);
+        break;
+    case GLFW_KEY_MINUS:
+        camera_.zoom(1.0 / 0.9);
+        break;
+    default:
+        break;
+    }
+    return KeyAction::None;
+}
+
+void SculptController::dispatch(const InputEvent& e) {
+    switch (e.type) {
+    case InputEvent::Type::Press:
+    case InputEvent::Type::Release:
+        onMove(e.x, e.y);
+        onButton(e.button, e.type == InputEvent::Type::Press, e.x, e.y, e.shift);
+        break;
+    case InputEvent::Type::Move:
+        onMove(e.x, e.y);
+        break;
+    case InputEvent::Type::Key:
+        onKey(e.key, e.ctrl, e.shift);
+        break;
+    case InputEvent::Type::Scroll:
+        onScroll(e.dy, e.ctrl);
+        break;
+    case InputEvent::Type::Drop:
+        break;
+    }
+}
+
+std::optional<glm::dvec3> SculptController::pick(double x, double y) const {
+    if (!doc_) return std::nullopt;
+    const Ray r = camera_.rayThrough(x, y, width_, height_);
+    const auto hit = raycastLevelSet(doc_->grid(), toEigen3(r.origin), toEigen3(r.direction),
+                                     1e3 * camera_.distance);
+    if (!hit) return std::nullopt;
+    return toGlm(*hit);
+}
+
+std::optional<glm::dvec3> SculptController::toolCentre() const {
+    if (drag_ == DragKind::Sculpt) {
+        if (settings_.mode == SculptMode::Clay) return std::nullopt;
+        return toGlm(last_.t);
+    }
+    if (drag_ == DragKind::None && !busy()) return pick(cursorX_, cursorY_);
+    return std::nullopt;
+}
+
+void SculptController::frameView() {
+    if (!doc_) return;
+    const Box b = activeWorldBox(doc_->grid());
+    camera_.frame(toGlm(b.min), toGlm(b.max));
+    volume_ = doc_->mesher().enclosedVolume();
+}
+
+// The tool placement for the cursor at (x, y) during a drag, by mode.
+Placement SculptController::placementAt(double x, double y) const {
+    Placement p;
+    p.t = toEigen3(grab_);
+    switch (settings_.mode) {
+    case SculptMode::Grab:
+    case SculptMode::Swirl:
+    case SculptMode::Clay:
+        p.t = toEigen3(grab_ +
+                       camera_.dragInViewPlane(grab_, pressX_, pressY_, x, y, width_, height_));
+        break;
+    case SculptMode::Twist:
+        p.axis = toEigen3(axis_);
+        p.angleDegrees = std::clamp(0.5 * (x - pressX_), -720.0, 720.0);
+        break;
+    case SculptMode::Inflate:
+        p.scale =
+            Eigen::Vector3d::Constant(std::exp(std::clamp(-(y - pressY_), -400.0, 400.0) * 0.004));
+        break;
+    }
+    return p;
+}
+
+std::vector<Placement> SculptController::placementsTo(const Placement& target) const {
+    if (settings_.mode != SculptMode::Twist) return {target};
+    // The cursor gives an absolute angle; the hand's way from the last one is the
+    // difference, however large, cut into equal turns no larger than the limit.
+    const double turn = target.angleDegrees - last_.angleDegrees;
+    const int pieces = std::max(1, int(std::ceil(std::abs(turn) / kMaxTwistStepDegrees)));
+    std::vector<Placement> out;
+    for (int k = 1; k <= pieces; ++k) {
+        Placement p = target;
+        p.angleDegrees =
+            k == pieces ? target.angleDegrees : last_.angleDegrees + turn * double(k) / pieces;
+        out.push_back(p);
+    }
+    return out;
+}
+
+void SculptController::launch(std::function<SegmentReport()> task) {
+    workSince_ = pendingSince_;
+    work_ = std::async(std::launch::async, std::move(task));
+    if (waitEach_) work_.wait();
+}
+
+// Takes finished work (its report, or why it failed).
+void SculptController::collect() {
+    if (!busy() || work_.wait_for(std::chrono::seconds(0)) != std::future_status::ready) return;
+    try {
+        finished_ = Finished{work_.get(), workSince_};
+    } catch (const Cancelled&) {
+        // The document has put the edit back already.
+        drag_ = DragKind::None;
+        releasing_ = pending_ = false;
+        volume_ = doc_->mesher().enclosedVolume();
+        message_ = "the stroke was cancelled; the shape is as it was before it";
+    } catch (const std::exception& e) {
+        doc_->endEdit();
+        drag_ = DragKind::None;
+        releasing_ = pending_ = false;
+        message_ = e.what();
+    }
+}
+
+void SculptController::finishDrag() {
+    doc_->endEdit();
+    volume_ = doc_->mesher().enclosedVolume();
+    drag_ = DragKind::None;
+    releasing_ = false;
+}
+
+// One piece of sculpting for the latest cursor position of a drag: a sweep segment (or a
+// few, for a fast twist), a swirl ring or a dab of clay.
+void SculptController::step() {
+    collect();
+    if (busy() || drag_ != DragKind::Sculpt) return;
+    if (pending_) {
+        pending_ = false;
+        Document* doc = doc_;
+        if (settings_.mode == SculptMode::Clay) {
+            // A new dab once the cursor has moved half a radius (in the view plane: the
+            // surface under a still cursor rises with every dab).
+            const double moved = glm::length(camera_.dragInViewPlane(
+                lastDab_, dabX_, dabY_, cursorX_, cursorY_, width_, height_));
+            if (moved >= 0.5 * settings_.radius) {
+                if (const auto hit = pick(cursorX_, cursorY_)) {
+                    dab(*hit);
+                    return;
+                }
+            }
+        } else if (const Placement p = placementAt(cursorX_, cursorY_); !(p == last_)) {
+            if (settings_.mode == SculptMode::Swirl) {
+                // A swirl ring carries the clay from the last position to this one.
+                SwirlStroke sw;
+                sw.at = last_.t;
+                sw.move = p.t - last_.t;
+                sw.radius = settings_.radius;
+                launch([doc, sw] { return doc->applyStroke(sw); });
+            } else {
+                const std::vector<Placement> path = placementsTo(p);
+                launch([doc, path] {
+                    SegmentReport r;
+                    for (const Placement& q : path)
+                        r = doc->extendStroke(q);
+                    return r;
+                });
+            }
+            last_ = p;
+            return;
+        }
+    }
+    if (releasing_) finishDrag();
+}
+
+void replayEvents(SculptController& controller, const std::vector<InputEvent>& events) {
+    const int lastFrame = events.empty() ? 1 : events.back().frame + 2;
+    std::size_t next = 0;
+    int frame = 0;
+    while (frame < lastFrame || controller.busy() || controller.drag() != DragKind::None) {
+        if (controller.readyForEvents())
+            for (; next < events.size() && events[next].frame == frame; ++next)
+                controller.dispatch(events[next]);
+        controller.step();
+        if (controller.readyForEvents()) ++frame;
+        if (frame > lastFrame + 1000) break; // a drag never released: stop waiting for it
+    }
+    controller.wait();
+    controller.step();
+}
+
+} // namespace sweepers

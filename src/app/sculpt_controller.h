@@ -1,0 +1,136 @@
+// The modeler's input logic without a window: mouse, key and wheel events in (window
+// pixels, origin top left), camera moves and sculpting out. A drag on the shape becomes
+// tool placements, and each piece of sculpting (a sweep segment, a swirl ring, a dab of
+// clay) runs on a worker thread while the window keeps drawing; moves that arrive
+// meanwhile coalesce into the next piece. The modeler feeds it GLFW's events; tests feed it
+// replay files and read the recorded script, with no window at all.
+#pragma once
+
+#include <chrono>
+#include <functional>
+#include <future>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "app/camera.h"
+#include "app/document.h"
+#include "app/input_replay.h"
+#include "levelset/interrupt.h"
+
+namespace sweepers {
+
+// Grab, twist and inflate are sweeps (one segment per piece); swirl moves clay while
+// keeping its volume (one swirl ring per piece, 4.1); clay adds material (Decaudin's
+// inflation, 2.30) under the cursor.
+enum class SculptMode { Grab, Twist, Inflate, Swirl, Clay };
+enum class DragKind { None, Sculpt, Orbit, Pan };
+
+struct ToolSettings {
+    SculptMode mode = SculptMode::Grab;
+    MirrorAxis mirror = MirrorAxis::None;
+    double radius = 0.25, falloff = 0.25;
+    bool wireframe = false;
+};
+
+// What a key asks of the window beyond the controller's own state.
+enum class KeyAction { None, Save, Cancel };
+
+class SculptController {
+  public:
+    using Clock = std::chrono::steady_clock;
+
+    // Twist drags are cut into placements at most this far apart, so that every segment
+    // turns the way the hand went, however fast it went (a segment's motion is the
+    // logarithm of the relative placement, which takes the short way round).
+    static constexpr double kMaxTwistStepDegrees = 60.0;
+
+    // waitEachPiece: every piece of sculpting is finished before the next event is taken
+    // (replays and tests: deterministic); otherwise events coalesce while one runs.
+    explicit SculptController(bool waitEachPiece = false) : waitEach_(waitEachPiece) {}
+    ~SculptController() { wait(); }
+
+    // The document sculpted (not owned); no work may be running when it changes.
+    void setDocument(Document* doc);
+    Document* document() const { return doc_; }
+    // The window's size in the pixels events are given in.
+    void setViewport(int width, int height);
+
+    // --- events -----------------------------------------------------------------------
+    // button: 0 left, 1 right, 2 middle.
+    void onButton(int button, bool press, double x, double y, bool shift);
+    void onMove(double x, double y);
+    void onScroll(double dy, bool ctrl);
+    KeyAction onKey(int key, bool ctrl, bool shift);
+    // A replayed event (all but drops, which open files: the window's job).
+    void dispatch(const InputEvent& e);
+
+    // Once per frame: takes finished work and starts the next piece of a drag.
+    void step();
+    // Replays take the next frame's events only when this is true (see waitEachPiece).
+    bool readyForEvents() const { return !busy() || !waitEach_; }
+    bool busy() const { return work_.valid(); }
+    void wait() const {
+        if (work_.valid()) work_.wait();
+    }
+    // Asks the running piece to stop: the document goes back to before the drag.
+    void cancel() { stop_.interrupt(); }
+
+    // --- what the window shows --------------------------------------------------------
+    OrbitCamera& camera() { return camera_; }
+    const OrbitCamera& camera() const { return camera_; }
+    ToolSettings& settings() { return settings_; }
+    const ToolSettings& settings() const { return settings_; }
+    DragKind drag() const { return drag_; }
+    // Where the tool is drawn: during a drag its current placement, else under the cursor.
+    std::optional<glm::dvec3> toolCentre() const;
+    // The surface point under a window pixel.
+    std::optional<glm::dvec3> pick(double x, double y) const;
+    // Looks at the whole shape.
+    void frameView();
+    double volume() const { return volume_; }
+
+    // A finished piece of sculpting: its report and when its first event arrived.
+    struct Finished {
+        SegmentReport report;
+        Clock::time_point since;
+    };
+    std::optional<Finished> takeFinished() { return std::exchange(finished_, std::nullopt); }
+    // A message for the user (a failed or cancelled piece), once.
+    std::string takeMessage() { return std::exchange(message_, std::string()); }
+
+  private:
+    Placement placementAt(double x, double y) const;
+    // The placements from the last one to `target`, each step small enough (twist).
+    std::vector<Placement> placementsTo(const Placement& target) const;
+    void launch(std::function<SegmentReport()> task);
+    void collect();
+    void dab(const glm::dvec3& p);
+    void finishDrag();
+
+    Document* doc_ = nullptr;
+    bool waitEach_ = false;
+    int width_ = 1, height_ = 1;
+    OrbitCamera camera_;
+    ToolSettings settings_;
+    DragKind drag_ = DragKind::None;
+    bool pending_ = false, releasing_ = false;
+    double pressX_ = 0, pressY_ = 0, lastX_ = 0, lastY_ = 0, cursorX_ = -1, cursorY_ = -1;
+    glm::dvec3 grab_{0.0}, axis_{0, 0, 1}, lastDab_{0.0};
+    double dabX_ = 0, dabY_ = 0;
+    Placement last_;
+    Clock::time_point pendingSince_, workSince_;
+    std::future<SegmentReport> work_;
+    FlagInterrupter stop_;
+    std::optional<Finished> finished_;
+    std::string message_;
+    double volume_ = 0.0;
+};
+
+// Replays events through a controller without a window, frame by frame as the modeler
+// does (events of a frame, then one step; drops are skipped), until every piece is done.
+void replayEvents(SculptController& controller, const std::vector<InputEvent>& events);
+
+} // namespace sweepers

@@ -1,0 +1,19 @@
+// Order statistics of timings (latency reports and benchmarks).
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <vector>
+
+namespace sweepers {
+
+// The q-quantile (0 <= q <= 1) of the values, nearest rank; 0 when there are none.
+inline double percentile(std::vector<double> values, double q) {
+    if (values.empty()) return 0.0;
+    std::sort(values.begin(), values.end());
+    const std::size_t i =
+        std::min(values.size() - 1, std::size_t(q * double(values.size() - 1) + 0.5));
+    return values[i];
+}
+
+} // namespace sweepers

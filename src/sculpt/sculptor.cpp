@@ -1,0 +1,87 @@
+#include "sculpt/sculptor.h"
+
+#include <chrono>
+
+namespace sweepers {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+} // namespace
+
+Sculptor::Sculptor(GridPtr grid, AdvectOptions options)
+    : grid_(std::move(grid)), options_(options) {}
+
+void Sculptor::setInterrupter(Interrupter* interrupter) {
+    options_.interrupter = interrupter;
+}
+
+void Sculptor::startMeshing() {
+    mesher_.rebuild(*grid_, options_.interrupter);
+    meshing_ = true;
+}
+
+void Sculptor::startRecording() {
+    record_ = LeafSnapshot();
+    recording_ = true;
+}
+
+LeafSnapshot Sculptor::stopRecording() {
+    recording_ = false;
+    return std::exchange(record_, LeafSnapshot());
+}
+
+void Sculptor::restoreRecording() {
+    record_.restore(*grid_);
+    if (meshing_) mesher_.update(*grid_, record_.bounds());
+    record_ = LeafSnapshot();
+}
+
+SegmentReport Sculptor::applySegment(const StepDeformation& deformation) {
+    if (recording_) record_.capture(*grid_, changedRegion(*grid_, deformation));
+    SegmentReport r;
+    const auto t0 = Clock::now();
+    r.stats = advectSegment(*grid_, deformation, options_);
+    r.seconds = since(t0);
+    if (meshing_) {
+        const auto t1 = Clock::now();
+        r.remeshedLeaves = mesher_.update(*grid_, r.stats.touched);
+        r.meshSeconds = since(t1);
+    }
+    return r;
+}
+
+SegmentReport Sculptor::applyStroke(const Stroke& stroke,
+                                    const std::function<void(const SegmentReport&)>& each) {
+    SegmentReport last;
+    const auto parts = planStroke(*grid_, stroke);
+    for (std::size_t k = 0; k < parts.size(); ++k) {
+        last = applySegment(*parts[k]);
+        last.segment = k;
+        if (each) each(last);
+    }
+    return last;
+}
+
+std::vector<SegmentReport> applyStrokes(Sculptor& sculptor, const std::vector<Stroke>& strokes,
+                                        const Progress& progress,
+                                        const std::function<void(std::size_t)>& after) {
+    std::size_t total = 0, done = 0;
+    for (const Stroke& s : strokes)
+        total += segmentCount(s);
+    std::vector<SegmentReport> reports;
+    for (std::size_t i = 0; i < strokes.size(); ++i) {
+        sculptor.applyStroke(strokes[i], [&](const SegmentReport& r) {
+            reports.push_back(r);
+            reports.back().stroke = i;
+            if (sculptor.meshing()) reports.back().meshVolume = sculptor.mesher().enclosedVolume();
+            if (progress) progress(++done, total);
+        });
+        if (after) after(i);
+    }
+    return reports;
+}
+
+} // namespace sweepers

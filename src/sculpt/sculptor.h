@@ -1,0 +1,82 @@
+// The one stroke path: a Sculptor owns a level set, the mesh kept up to date with it, and
+// the undo record of the edit in progress, and applies strokes to them segment by segment.
+// The command line (applyStrokes) and the modeler's document both go through
+// applySegment, so a recorded session replays to the same grid by construction.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <vector>
+
+#include "levelset/advect.h"
+#include "levelset/interrupt.h"
+#include "levelset/leaf_snapshot.h"
+#include "mesh/marching_cubes.h"
+#include "sculpt/stroke.h"
+
+namespace sweepers {
+
+struct SegmentReport {
+    std::size_t stroke = 0, segment = 0;
+    AdvectStats stats;
+    double seconds = 0.0;     // advection, renormalization included
+    double meshSeconds = 0.0; // incremental re-meshing of the touched leaves (when meshing)
+    std::size_t remeshedLeaves = 0;
+    double meshVolume = 0.0; // enclosed volume of the mesh after the segment (applyStrokes,
+                             // when meshing: it sums the whole mesh)
+};
+
+// Progress: (steps done, steps in all).
+using Progress = std::function<void(std::size_t, std::size_t)>;
+
+class Sculptor {
+  public:
+    explicit Sculptor(GridPtr grid, AdvectOptions options = {});
+
+    Grid& grid() { return *grid_; }
+    const Grid& grid() const { return *grid_; }
+    GridPtr gridPtr() const { return grid_; }
+
+    // Polled during every segment (and by whole-grid meshing); null: never stops. A
+    // cancelled segment throws Cancelled with the grid half-advected: restore the recording
+    // (or drop the grid).
+    void setInterrupter(Interrupter* interrupter);
+    Interrupter* interrupter() const { return options_.interrupter; }
+
+    // Keeps a marching-cubes mesh up to date after every segment (built now, whole).
+    void startMeshing();
+    bool meshing() const { return meshing_; }
+    SurfaceMesher& mesher() { return mesher_; }
+    const SurfaceMesher& mesher() const { return mesher_; }
+
+    // Undo: while recording, every block a segment may change is saved once, before it
+    // changes. stopRecording hands the saved blocks over.
+    void startRecording();
+    LeafSnapshot stopRecording();
+    // Puts the recorded blocks back (the grid as it was at startRecording) and re-meshes
+    // them; the recording goes on, empty.
+    void restoreRecording();
+
+    // The stroke step: one deformation advected (band growth, sampling, renormalization),
+    // then the touched leaves re-meshed.
+    SegmentReport applySegment(const StepDeformation& deformation);
+    // Every segment of a stroke, planned on the grid as it is now; `each` sees every
+    // segment's report. Returns the last.
+    SegmentReport applyStroke(const Stroke& stroke,
+                              const std::function<void(const SegmentReport&)>& each = {});
+
+  private:
+    GridPtr grid_;
+    AdvectOptions options_;
+    SurfaceMesher mesher_;
+    bool meshing_ = false, recording_ = false;
+    LeafSnapshot record_;
+};
+
+// Applies strokes in order, reporting every segment (stroke index and segment within it);
+// `after` (if set) runs after each stroke with its index.
+std::vector<SegmentReport> applyStrokes(Sculptor& sculptor, const std::vector<Stroke>& strokes,
+                                        const Progress& progress = {},
+                                        const std::function<void(std::size_t)>& after = {});
+
+} // namespace sweepers

@@ -1,0 +1,68 @@
+#include "sculpt/stroke.h"
+
+#include "deform/inflate.h"
+#include "levelset/level_set.h"
+#include "tools/ellipsoid.h"
+
+namespace sweepers {
+
+namespace {
+template <class... F> struct Overloaded : F... { using F::operator()...; };
+template <class... F> Overloaded(F...) -> Overloaded<F...>;
+} // namespace
+
+Sweep toSweep(const SweepStroke& stroke) {
+    Sweep sweep;
+    sweep.mirror = stroke.mirror;
+    for (const ToolSpec& t : stroke.tools) {
+        SweptTool st;
+        st.shape = t.shape == ToolShapeKind::Ball ? std::make_shared<EllipsoidShape>(t.size.x())
+                                                  : std::make_shared<EllipsoidShape>(t.size);
+        st.falloff = t.falloff;
+        st.path = t.path;
+        sweep.tools.push_back(std::move(st));
+    }
+    return sweep;
+}
+
+SwirlSpec toSwirl(const SwirlStroke& stroke) {
+    SwirlSpec s;
+    s.at = stroke.at;
+    s.move = stroke.move;
+    s.radius = stroke.radius;
+    s.ring = stroke.ring;
+    s.swirls = stroke.swirls;
+    return s;
+}
+
+std::size_t segmentCount(const Stroke& stroke) {
+    if (const auto* sweep = std::get_if<SweepStroke>(&stroke))
+        return toSweep(*sweep).segmentCount();
+    return 1;
+}
+
+std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke) {
+    // Planned when the stroke comes: an inflation's reach is the shape as it is then.
+    std::vector<std::unique_ptr<StepDeformation>> parts;
+    const Box reach = activeWorldBox(grid).expanded(2 * grid.voxelSize()[0]);
+    std::visit(Overloaded{
+                   [&](const SweepStroke& s) {
+                       const Sweep sweep = toSweep(s);
+                       for (std::size_t k = 0; k < sweep.segmentCount(); ++k)
+                           parts.push_back(std::make_unique<SweepSegment>(sweep, k));
+                   },
+                   [&](const SwirlStroke& s) {
+                       if (s.ball > 0.0)
+                           parts.push_back(starShapedSwirl(toSwirl(s), s.ball, reach));
+                       else
+                           parts.push_back(std::make_unique<SwirlSegment>(toSwirl(s)));
+                   },
+                   [&](const InflateStroke& s) {
+                       parts.push_back(std::make_unique<Inflation>(s.at, s.radius, reach));
+                   },
+               },
+               stroke);
+    return parts;
+}
+
+} // namespace sweepers

@@ -1,0 +1,88 @@
+// The stroke model: what a sculptor does to a shape, as data. A stroke script (io/) and
+// the modeler's drags (app/) both produce these; planStroke is the one place where a
+// stroke kind becomes deformations.
+//
+//   sweep   - tools (balls or ellipsoids) moved along paths of placements (thesis 3.3)
+//   swirl   - a ring of swirls carrying clay while keeping its volume (4.1-4.19)
+//   inflate - Decaudin's inflation adding a ball of material (2.30)
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <variant>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "deform/placement.h"
+#include "deform/step_deformation.h"
+#include "deform/sweep.h"
+#include "deform/swirl.h"
+#include "levelset/vdb.h"
+
+namespace sweepers {
+
+struct GridSpec {
+    double voxelSize = 0.02;
+    double halfWidth = 3.0; // in voxels
+};
+
+struct StartShape {
+    enum class Kind { Sphere, Vdb, Mesh };
+    Kind kind = Kind::Sphere;
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
+    double radius = 1.0;
+    std::string file; // as written in the script (relative to it)
+};
+
+enum class ToolShapeKind { Ball, Ellipsoid };
+
+struct ToolSpec {
+    ToolShapeKind shape = ToolShapeKind::Ball;
+    Eigen::Vector3d size = Eigen::Vector3d::Constant(0.3); // ball: all three equal
+    double falloff = 0.3;
+    std::vector<Placement> path;
+};
+
+struct SweepStroke {
+    MirrorAxis mirror = MirrorAxis::None;
+    std::vector<ToolSpec> tools;
+};
+
+struct SwirlStroke {
+    Eigen::Vector3d at = Eigen::Vector3d::Zero();
+    Eigen::Vector3d move = Eigen::Vector3d::Zero();
+    double radius = 0.3;
+    SwirlRing ring = SwirlRing::Discrete;
+    int swirls = 8;
+    double ball = 0.0; // > 0: star-shaped swirl carrying a ball of this radius (4.19)
+};
+
+struct InflateStroke {
+    Eigen::Vector3d at = Eigen::Vector3d::Zero();
+    double radius = 0.1;
+};
+
+using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke>;
+
+struct StrokeScript {
+    int version = 1;
+    GridSpec grid;
+    StartShape start;
+    std::vector<Stroke> strokes;
+};
+
+// The deformation a sweep stroke describes.
+Sweep toSweep(const SweepStroke& stroke);
+// The swirl ring a swirl stroke describes.
+SwirlSpec toSwirl(const SwirlStroke& stroke);
+
+// How many deformations planStroke makes of a stroke (a sweep's segments, else one).
+std::size_t segmentCount(const Stroke& stroke);
+
+// The deformations of one stroke, in order: a sweep's segments, or one swirl ring or
+// inflation (whose reach depends on the grid as it is when the stroke comes).
+std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke);
+
+} // namespace sweepers

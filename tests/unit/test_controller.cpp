@@ -1,0 +1,177 @@
+// The modeler's input logic without a window: drags become placements and strokes, fast
+// twists keep the hand's direction, and long work can be cancelled, leaving the document
+// and the mesh as they were.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "app/sculpt_controller.h"
+#include "grids.h"
+#include "levelset/fast_marching.h"
+#include "levelset/level_set.h"
+
+using namespace sweepers;
+using sweepers::test::differingVoxels;
+
+namespace {
+
+constexpr int kWidth = 640, kHeight = 480;
+
+// Says stop at its n-th poll (counting from 1), and at every poll after.
+class StopAfter : public Interrupter {
+  public:
+    explicit StopAfter(int n) : left_(n) {}
+    bool wasInterrupted(int = -1) override { return --left_ <= 0; }
+
+  private:
+    std::atomic<int> left_;
+};
+
+struct Session {
+    Document doc{Document::sphereScript(1.0 / 32), "."};
+    SculptController ctl{/*waitEachPiece=*/true};
+    Session() {
+        ctl.setViewport(kWidth, kHeight);
+        ctl.setDocument(&doc);
+        ctl.frameView();
+    }
+    // A twist drag from the centre of the view `pixels` to the right, in moves of `step`
+    // pixels (one move when step >= pixels), one frame each.
+    void twist(double pixels, double step) {
+        ctl.onKey('T', false, false);
+        const double x0 = kWidth / 2.0, y0 = kHeight / 2.0;
+        ctl.onButton(0, true, x0, y0, false);
+        ASSERT_EQ(ctl.drag(), DragKind::Sculpt) << "the press missed the sphere";
+        for (double d = std::min(step, pixels);; d = std::min(d + step, pixels)) {
+            ctl.onMove(x0 + d, y0);
+            ctl.step();
+            if (d >= pixels) break;
+        }
+        ctl.onButton(0, false, x0 + pixels, y0, false);
+        ctl.wait();
+        ctl.step();
+        ASSERT_EQ(ctl.drag(), DragKind::None);
+        ASSERT_EQ(ctl.takeMessage(), "");
+    }
+    const ToolSpec& tool() const {
+        return std::get<SweepStroke>(doc.script().strokes.back()).tools[0];
+    }
+};
+
+// How far (degrees, signed, unwrapped) a point of the tool's coating turns about the twist
+// axis through all the segments of the recorded stroke.
+double coatingTurn(const ToolSpec& tool) {
+    const Sweep sweep = toSweep(SweepStroke{MirrorAxis::None, {tool}});
+    const Eigen::Vector3d c = tool.path[0].t, axis = tool.path[1].axis.normalized();
+    const Eigen::Vector3d u = axis.unitOrthogonal(), v = axis.cross(u);
+    // Half-way through the falloff: the coating turns by part of the tool's angle.
+    Eigen::Vector3d p = c + (tool.size.x() + 0.5 * tool.falloff) * u;
+    double turned = 0.0;
+    auto angle = [&](const Eigen::Vector3d& q) {
+        const Eigen::Vector3d d = q - c;
+        return std::atan2(d.dot(v), d.dot(u)) * 180.0 / M_PI;
+    };
+    for (std::size_t k = 0; k < sweep.segmentCount(); ++k) {
+        const double before = angle(p);
+        p = SweepSegment(sweep, k).forwardMap(p).p;
+        double d = angle(p) - before;
+        d -= 360.0 * std::round(d / 360.0); // one segment turns less than half a turn
+        turned += d;
+    }
+    return turned;
+}
+
+} // namespace
+
+TEST(SculptController, AFastTwistTurnsTheWayTheHandWent) {
+    // 2000 pixels right in one move (the angle saturates at 720 degrees) against the same
+    // drag in 20-pixel moves, and 400 pixels (200 degrees) both ways.
+    for (const double pixels : {400.0, 2000.0}) {
+        Session slow, flick;
+        slow.twist(pixels, 20);
+        flick.twist(pixels, pixels);
+        for (const Session* s : {&slow, &flick}) {
+            const auto& path = s->tool().path;
+            for (std::size_t i = 1; i < path.size(); ++i)
+                ASSERT_LT(std::abs(path[i].angleDegrees - path[i - 1].angleDegrees),
+                          SculptController::kMaxTwistStepDegrees + 1e-9)
+                    << "placements " << i - 1 << " and " << i;
+            EXPECT_DOUBLE_EQ(path.back().angleDegrees, std::min(0.5 * pixels, 720.0));
+        }
+        const double a = coatingTurn(slow.tool()), b = coatingTurn(flick.tool());
+        std::printf("[ twist ] %g pixels: the coating turns %.2f degrees (slow drag, %zu "
+                    "placements) and %.2f (one move, %zu placements)\n",
+                    pixels, a, slow.tool().path.size(), b, flick.tool().path.size());
+        EXPECT_GT(a, 10.0);
+        EXPECT_NEAR(b, a, 0.02 * a);
+    }
+}
+
+TEST(SculptController, EscapeCancelsTheDragAndPutsTheShapeBack) {
+    Session s;
+    const GridPtr before = s.doc.grid().deepCopy();
+    const double volume = s.doc.mesher().enclosedVolume();
+    s.ctl.onKey('G', false, false);
+    s.ctl.onButton(0, true, kWidth / 2.0, kHeight / 2.0, false);
+    s.ctl.onMove(kWidth / 2.0 + 30, kHeight / 2.0);
+    s.ctl.step();
+    s.ctl.wait();
+    s.ctl.step();
+    ASSERT_GT(differingVoxels(*before, s.doc.grid()), 100u);
+    // The next segment is cancelled (Esc while it runs is the same flag, set earlier).
+    s.ctl.onMove(kWidth / 2.0 + 60, kHeight / 2.0);
+    s.ctl.cancel();
+    s.ctl.step();
+    s.ctl.wait();
+    s.ctl.step();
+    EXPECT_EQ(s.ctl.drag(), DragKind::None);
+    EXPECT_NE(s.ctl.takeMessage().find("cancelled"), std::string::npos);
+    EXPECT_EQ(differingVoxels(*before, s.doc.grid()), 0u);
+    EXPECT_DOUBLE_EQ(s.doc.mesher().enclosedVolume(), volume);
+    EXPECT_TRUE(s.doc.script().strokes.empty());
+    EXPECT_FALSE(s.doc.canUndo());
+    // And sculpting goes on afterwards.
+    s.ctl.onButton(0, true, kWidth / 2.0, kHeight / 2.0, false);
+    s.ctl.onMove(kWidth / 2.0 + 30, kHeight / 2.0);
+    s.ctl.step();
+    s.ctl.onButton(0, false, kWidth / 2.0 + 30, kHeight / 2.0, false);
+    s.ctl.wait();
+    s.ctl.step();
+    EXPECT_EQ(s.doc.script().strokes.size(), 1u);
+}
+
+TEST(Cancel, EveryLongOperationStopsAndLeavesItsInputAsItWas) {
+    const GridPtr sphere = makeSphere({0, 0, 0}, 1.0, 1.0 / 48, 3.0);
+    // Renormalization: nothing written back.
+    {
+        GridPtr g = sphere->deepCopy();
+        for (auto it = g->tree().beginValueOn(); it; ++it)
+            it.setValue(1.5f * *it); // no longer a distance
+        const GridPtr stretched = g->deepCopy();
+        StopAfter stop(2);
+        EXPECT_THROW(renormalizeAll(*g, FmmOrder::Second, &stop), Cancelled);
+        EXPECT_EQ(differingVoxels(*stretched, *g), 0u);
+    }
+    // Whole-grid meshing: the mesher keeps its mesh.
+    {
+        SurfaceMesher mesher;
+        mesher.rebuild(*makeSphere({0, 0, 0}, 0.5, 1.0 / 48, 3.0));
+        const std::size_t triangles = mesher.triangleCount();
+        StopAfter stop(3);
+        EXPECT_THROW(mesher.rebuild(*sphere, &stop), Cancelled);
+        EXPECT_EQ(mesher.triangleCount(), triangles);
+    }
+    // Mesh import.
+    {
+        const TriangleMesh m = meshLevelSet(*sphere);
+        StopAfter stop(1);
+        EXPECT_THROW(levelSetFromMesh(m.positions, m.triangles, 1.0 / 48, 3.0, &stop), Cancelled);
+    }
+    // A resample (a history replayed): no document is made.
+    {
+        StrokeScript script = Document::sphereScript(1.0 / 32);
+        script.strokes.push_back(InflateStroke{{0, 0, 0.9}, 0.2});
+        StopAfter stop(5);
+        EXPECT_THROW(Document::replayAt(script, ".", 1.0 / 48, {}, &stop), Cancelled);
+    }
+}
