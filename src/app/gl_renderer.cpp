@@ -196,8 +196,9 @@ void GlRenderer::uploadBrick(const SurfaceMesher& mesher, const openvdb::Coord& 
         glEnableVertexAttribArray(0);
         glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
         glEnableVertexAttribArray(1);
+        // OpenGL takes a byte offset into the bound buffer as a pointer.
         glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float),
-                              reinterpret_cast<void*>(3 * sizeof(float)));
+                              reinterpret_cast<void*>(3 * sizeof(float))); // NOLINT
     }
     glBindVertexArray(m.vao);
     glBindBuffer(GL_ARRAY_BUFFER, m.vbo);

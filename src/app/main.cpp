@@ -8,7 +8,7 @@
 #include "app/modeler.h"
 #include "io/stroke_script.h"
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
     sweepers::ModelerOptions o;
     o.argv0 = argv[0];
     std::string script, size;
@@ -57,6 +57,16 @@ int main(int argc, char** argv) {
             limit = std::make_unique<tbb::global_control>(
                 tbb::global_control::max_allowed_parallelism, threads);
         return sweepers::runModeler(o);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "sweepers: %s\n", e.what());
+        return 1;
+    }
+}
+
+int main(int argc, char** argv) {
+    // What run does not catch itself (running out of memory while setting up).
+    try {
+        return run(argc, argv);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "sweepers: %s\n", e.what());
         return 1;

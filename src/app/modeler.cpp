@@ -170,7 +170,7 @@ class Modeler {
     }
 
     using Maker = std::function<std::unique_ptr<Document>(const Progress&, Interrupter*)>;
-    void startJob(const std::string& what, Maker make) {
+    void startJob(const std::string& what, const Maker& make) {
         auto done = std::make_shared<std::atomic<std::size_t>>(0);
         auto total = std::make_shared<std::atomic<std::size_t>>(0);
         auto stop = std::make_shared<FlagInterrupter>();

@@ -213,7 +213,7 @@ int runApply(const ApplyArgs& a) {
 
 } // namespace
 
-int main(int argc, char** argv) {
+static int run(int argc, char** argv) {
     CLI::App app{"sweepers-cli: sculpt narrow-band level sets with sweepers"};
     app.set_version_flag("--version", "sweepers-cli " SWEEPERS_VERSION);
     app.require_subcommand(1);
@@ -303,4 +303,14 @@ int main(int argc, char** argv) {
         return 1;
     }
     return 0;
+}
+
+int main(int argc, char** argv) {
+    // What run does not catch itself (running out of memory while setting up).
+    try {
+        return run(argc, argv);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "sweepers-cli: %s\n", e.what());
+        return 1;
+    }
 }

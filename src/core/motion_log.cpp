@@ -96,7 +96,7 @@ MotionLog MotionLog::log(const Eigen::Matrix4d& M) {
     // u = V diag(log s_i / (s_i - 1)) V^T t.
     if ((A - A.transpose()).cwiseAbs().maxCoeff() < 1e-12 * A.cwiseAbs().maxCoeff()) {
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (A + A.transpose()));
-        const Eigen::Vector3d s = eig.eigenvalues();
+        const Eigen::Vector3d& s = eig.eigenvalues();
         if (s.minCoeff() > 0.0) {
             const Eigen::Matrix3d& V = eig.eigenvectors();
             Eigen::Vector3d logS, inv;

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -12,7 +13,7 @@ inline double percentile(std::vector<double> values, double q) {
     if (values.empty()) return 0.0;
     std::sort(values.begin(), values.end());
     const std::size_t i =
-        std::min(values.size() - 1, std::size_t(q * double(values.size() - 1) + 0.5));
+        std::min(values.size() - 1, std::size_t(std::lround(q * double(values.size() - 1))));
     return values[i];
 }
 

@@ -80,7 +80,8 @@ class Domain {
         if (v >= 0 && v < 8) return dir > 0 ? i + stride[a] : i - stride[a];
         const int nl = neighbours_[i >> 9][2 * a + (dir > 0)];
         if (nl < 0) return npos;
-        return (std::size_t(nl) << 9) + off + (dir > 0 ? -7 : 7) * stride[a];
+        // The same row or column of the neighbouring leaf, at its other end.
+        return (std::size_t(nl) << 9) + std::size_t(off + (dir > 0 ? -7 : 7) * stride[a]);
     }
 
     std::vector<float> phi;

@@ -69,7 +69,8 @@ std::unique_ptr<PlacedShape> EllipsoidShape::place(const Eigen::Affine3d& X) con
     const Eigen::Matrix3d G = X.linear() * semiAxes_.asDiagonal();
     const Eigen::Vector3d c = X.translation();
     Eigen::JacobiSVD<Eigen::Matrix3d> svd(G, Eigen::ComputeFullU);
-    const Eigen::Vector3d a = svd.singularValues();
+    // A copy: through a reference into the solver GCC 12 warns of uninitialized values.
+    const Eigen::Vector3d a = svd.singularValues(); // NOLINT(performance-*)
     if (!(a.minCoeff() > 0.0)) throw std::invalid_argument("a tool placement collapses the tool");
     if (a.maxCoeff() - a.minCoeff() <= 1e-12 * a.maxCoeff())
         return std::make_unique<PlacedBall>(c, a.mean());

@@ -6,6 +6,7 @@
 
 #include "app/camera.h"
 #include "app/input_replay.h"
+#include "scratch_dir.h"
 
 using namespace sweepers;
 
@@ -28,7 +29,8 @@ TEST(OrbitCamera, CentrePixelLooksAtTheTargetAndDragsFollowTheCursor) {
 
 namespace {
 std::string refused(const std::string& text) {
-    const std::string path = ::testing::TempDir() + "/events.json";
+    const test::ScratchDir dir;
+    const std::string path = dir / "events.json";
     std::ofstream(path) << text;
     try {
         readInputEvents(path);
@@ -40,7 +42,8 @@ std::string refused(const std::string& text) {
 } // namespace
 
 TEST(InputReplay, ReadsEventsAndRefusesBadOnesWithTheirPlace) {
-    const std::string path = ::testing::TempDir() + "/ok.json";
+    const test::ScratchDir dir;
+    const std::string path = dir / "ok.json";
     std::ofstream(path) << R"({"events": [
         {"frame": 1, "type": "press", "button": "right", "x": 10, "y": 20},
         {"frame": 1, "type": "move", "x": 11, "y": 21},

@@ -7,6 +7,7 @@
 #include "io/mesh_file.h"
 #include "levelset/raycast.h"
 #include "replay.h"
+#include "scratch_dir.h"
 
 using namespace sweepers;
 using sweepers::test::differingVoxels;
@@ -131,7 +132,8 @@ TEST(Raycast, HitsTheSphereWhereTheRayEntersIt) {
 
 TEST(Document, ImportsAMeshAndReplaysItsHistoryAtAnotherVoxelSize) {
     Document sphere(Document::sphereScript(1.0 / 32), ".");
-    const std::string stl = ::testing::TempDir() + "/sphere.stl";
+    const test::ScratchDir dir;
+    const std::string stl = dir / "sphere.stl";
     writeMesh(sphere.mesher().weld(), stl);
     Document imported = Document::open(stl, 1.0 / 32);
     EXPECT_EQ(imported.script().start.kind, StartShape::Kind::Mesh);
@@ -148,7 +150,8 @@ TEST(Document, ImportsAMeshAndReplaysItsHistoryAtAnotherVoxelSize) {
 
 TEST(Document, AVdbStartIsNotReplayedAtAnotherVoxelSize) {
     Document sphere(Document::sphereScript(1.0 / 32), ".");
-    const std::string vdb = ::testing::TempDir() + "/start.vdb";
+    const test::ScratchDir dir;
+    const std::string vdb = dir / "start.vdb";
     sphere.saveVdb(vdb);
     const Document opened = Document::open(vdb);
     EXPECT_EQ(differingVoxels(opened.grid(), sphere.grid()), 0u);

@@ -10,23 +10,14 @@
 #include "io/vdb_file.h"
 #include "levelset/level_set.h"
 #include "mesh/marching_cubes.h"
+#include "scratch_dir.h"
 
 using namespace sweepers;
 namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    TempDir() : path(fs::temp_directory_path() / ("sweepers_files_" + std::to_string(::getpid()))) {
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-    std::string operator/(const std::string& f) const { return (path / f).string(); }
-    std::size_t count() const {
-        return std::size_t(std::distance(fs::directory_iterator(path), fs::directory_iterator()));
-    }
-};
+using test::ScratchDir;
 
 std::string errorOf(const std::function<void()>& f) {
     try {
@@ -46,7 +37,7 @@ void writeGrids(const std::string& path, openvdb::GridPtrVec grids) {
 } // namespace
 
 TEST(VdbFile, RoundTripIsBitExact) {
-    TempDir dir;
+    ScratchDir dir;
     GridPtr g = makeSphere({0.1, 0.2, 0.3}, 0.5, 1.0 / 50, 3);
     writeLevelSet(*g, dir / "s.vdb");
     EXPECT_EQ(dir.count(), 1u); // no temporary left behind
@@ -68,7 +59,7 @@ TEST(VdbFile, RoundTripIsBitExact) {
 }
 
 TEST(VdbFile, ReadsTheFirstLevelSetAndRefusesOtherGrids) {
-    TempDir dir;
+    ScratchDir dir;
     initVdb();
     openvdb::FloatGrid::Ptr fog = openvdb::FloatGrid::create(0.0f);
     fog->setName("density");
@@ -107,14 +98,14 @@ TEST(VdbFile, ReadsTheFirstLevelSetAndRefusesOtherGrids) {
 }
 
 TEST(VdbFile, UnwritableTargetFailsCleanly) {
-    TempDir dir;
+    ScratchDir dir;
     GridPtr g = makeSphere({0, 0, 0}, 0.5, 0.05, 3);
     EXPECT_THROW(writeLevelSet(*g, dir / "no/such/dir/x.vdb"), std::runtime_error);
     EXPECT_EQ(dir.count(), 0u);
 }
 
 TEST(MeshFile, ExportsReadBackWatertight) {
-    TempDir dir;
+    ScratchDir dir;
     GridPtr g = makeSphere({0, 0, 0}, 0.6, 1.0 / 30, 3);
     const TriangleMesh mesh = meshLevelSet(*g);
     for (const char* name : {"s.obj", "s.ply", "s.stl"}) {
@@ -133,7 +124,7 @@ TEST(MeshFile, ExportsReadBackWatertight) {
 }
 
 TEST(MeshFile, MeshStartBecomesALevelSet) {
-    TempDir dir;
+    ScratchDir dir;
     GridPtr g = makeSphere({0, 0, 0}, 0.6, 1.0 / 30, 3);
     writeMesh(meshLevelSet(*g), dir / "s.obj");
     const TriangleMesh m = readMesh(dir / "s.obj");

@@ -1,0 +1,120 @@
+// The data scripts end to end on real grids: the heavy engine tests, labelled `slow`. Each
+// runs at the voxel size it names, or at twice it (eight times fewer voxels) when
+// SWEEPERS_COARSE_TESTS is set, as the sanitizer builds do.
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "io/start_grid.h"
+#include "io/stroke_script.h"
+#include "levelset/level_set.h"
+#include "levelset/measure.h"
+#include "mesh/marching_cubes.h"
+#include "replay.h"
+
+using namespace sweepers;
+
+namespace {
+
+bool coarse() {
+    return std::getenv("SWEEPERS_COARSE_TESTS") != nullptr;
+}
+
+std::string dataPath(const std::string& name) {
+    return std::string(SWEEPERS_DATA_DIR) + "/" + name + ".json";
+}
+
+// The voxel size a test runs at: `fine`, or twice it in the coarse variant.
+double voxelSize(double fine) {
+    return coarse() ? 2.0 * fine : fine;
+}
+
+Placement at(const Eigen::Vector3d& t) {
+    Placement p;
+    p.t = t;
+    return p;
+}
+
+class DataScript : public ::testing::TestWithParam<const char*> {};
+
+} // namespace
+
+TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
+    const std::string name = GetParam();
+    const StrokeScript script = readStrokeScript(dataPath(name));
+    const double h = voxelSize(script.grid.voxelSize);
+    applyScript(script, SWEEPERS_DATA_DIR, h, [&](std::size_t stroke, const Grid& g) {
+        const BandReport r = checkBand(g);
+        EXPECT_EQ(r.vdbCheck, "") << name << " stroke " << stroke;
+        EXPECT_GE(r.unitGradientFraction(), 0.95) << name << " stroke " << stroke;
+        EXPECT_EQ(r.beyondBand, 0u) << name << " stroke " << stroke;
+        std::printf("[ band ] %s at 1/%g, stroke %zu: %zu active, |grad| in [0.9, 1.1] on "
+                    "%.2f%% of %zu interface voxels\n",
+                    name.c_str(), 1.0 / h, stroke, r.activeVoxels, 100 * r.unitGradientFraction(),
+                    r.nearInterface);
+    });
+}
+
+INSTANTIATE_TEST_SUITE_P(Data, DataScript,
+                         ::testing::Values("drag", "horn", "mirrored_ears", "pinch", "pull",
+                                           "starfish_swirls", "twisted_limb"),
+                         [](const auto& info) { return std::string(info.param); });
+
+TEST(DataScripts, EveryScriptInDataIsCovered) {
+    // A script added to data/ must be added to the list above.
+    std::size_t scripts = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(SWEEPERS_DATA_DIR))
+        scripts += entry.path().extension() == ".json";
+    EXPECT_EQ(scripts, 7u);
+}
+
+TEST(Advect, PinchOpensAHole) {
+    // At the script's voxel size only: the squeeze is one voxel thin there on purpose.
+    const StrokeScript script = readStrokeScript(dataPath("pinch"));
+    Sculptor sculptor(makeStartGrid(script, SWEEPERS_DATA_DIR));
+    const GridPtr g = sculptor.gridPtr();
+    EXPECT_EQ(topologicalEulerCharacteristic(*g), 2);
+    EXPECT_EQ(meshTopology(meshLevelSet(*g)).eulerCharacteristic(), 2);
+    applyStrokes(sculptor, script.strokes);
+    const TriangleMesh mesh = meshLevelSet(*g);
+    const MeshTopology t = meshTopology(mesh);
+    EXPECT_EQ(topologicalEulerCharacteristic(*g), 0);
+    EXPECT_EQ(t.eulerCharacteristic(), 0);
+    EXPECT_TRUE(t.watertight());
+    EXPECT_TRUE(t.consistentlyOriented());
+}
+
+TEST(Advect, SwirlsKeepVolumeWhereSweepsDoNot) {
+    // The 50-stroke swirl script against sweeps of a ball along the same moves.
+    const StrokeScript swirls = readStrokeScript(dataPath("starfish_swirls"));
+    StrokeScript sweeps = swirls;
+    sweeps.strokes.clear();
+    for (const Stroke& s : swirls.strokes) {
+        const auto& sw = std::get<SwirlStroke>(s);
+        ToolSpec tool;
+        tool.shape = ToolShapeKind::Ball;
+        tool.size = Eigen::Vector3d::Constant(0.1);
+        tool.falloff = sw.radius;
+        tool.path = {at(sw.at), at(sw.at + sw.move)};
+        SweepStroke stroke;
+        stroke.tools.push_back(tool);
+        sweeps.strokes.emplace_back(stroke);
+    }
+    ASSERT_EQ(swirls.strokes.size(), 50u);
+    const double h = voxelSize(1.0 / 128); // a unit sphere 256 voxels across
+    Sculptor a(makeStartGrid(swirls, SWEEPERS_DATA_DIR, h)), b(a.grid().deepCopy());
+    const double v0 = measureLevelSet(a.grid()).volume;
+    applyStrokes(a, swirls.strokes);
+    applyStrokes(b, sweeps.strokes);
+    const double swirlDrift = (measureLevelSet(a.grid()).volume - v0) / v0;
+    const double sweepDrift = (measureLevelSet(b.grid()).volume - v0) / v0;
+    std::printf("[ volume ] 50 strokes at voxel size %g: swirls %+.3f%%, sweeps %+.3f%%\n", h,
+                100 * swirlDrift, 100 * sweepDrift);
+    EXPECT_LT(std::abs(swirlDrift), 0.01);
+    EXPECT_GT(std::abs(sweepDrift), 10 * std::abs(swirlDrift));
+    EXPECT_EQ(topologicalEulerCharacteristic(a.grid()), 2);
+}
