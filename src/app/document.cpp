@@ -8,7 +8,7 @@
 #include "io/mesh_file.h"
 #include "io/start_grid.h"
 #include "io/vdb_file.h"
-#include "levelset/level_set.h"
+#include "levelset/create.h"
 
 namespace sweepers {
 

@@ -15,6 +15,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/type_ptr.hpp>
 
+#include "levelset/stencils.h"
+
 namespace sweepers {
 
 namespace {
@@ -64,13 +66,8 @@ unsigned program(const std::string& dir, const std::string& name) {
     return p;
 }
 
-int floorDiv(int v, int d) {
-    return v >= 0 ? v / d : -((-v + d - 1) / d);
-}
-
 openvdb::Coord brickOf(const openvdb::Coord& c) {
-    return {floorDiv(c.x(), kBrick) * kBrick, floorDiv(c.y(), kBrick) * kBrick,
-            floorDiv(c.z(), kBrick) * kBrick};
+    return floorToMultiple(c, kBrick);
 }
 
 void setMatrix(unsigned prog, const char* name, const glm::mat4& m) {

@@ -29,7 +29,7 @@
 #include "core/statistics.h"
 #include "io/atomic_file.h"
 #include "io/mesh_file.h"
-#include "levelset/level_set.h"
+#include "levelset/band.h"
 
 namespace sweepers {
 

@@ -7,7 +7,7 @@
 #define GLFW_INCLUDE_NONE // key codes only: this file uses no window
 #include <GLFW/glfw3.h>
 
-#include "levelset/level_set.h"
+#include "levelset/band.h"
 #include "levelset/raycast.h"
 
 namespace sweepers {

@@ -5,7 +5,7 @@
 #include "io/mesh_file.h"
 #include "io/stroke_script.h"
 #include "io/vdb_file.h"
-#include "levelset/level_set.h"
+#include "levelset/create.h"
 
 namespace sweepers {
 

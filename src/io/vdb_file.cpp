@@ -6,7 +6,7 @@
 #include <openvdb/io/File.h>
 
 #include "io/atomic_file.h"
-#include "levelset/level_set.h"
+#include "levelset/create.h"
 
 namespace sweepers {
 

@@ -1,8 +1,8 @@
-// VDB files (DESIGN.md section 5): one FloatGrid named "surface", class level set, linear
-// transform with the voxel size, background = half-width x voxel size, negative inside,
-// metadata creator / voxel_size / half_width. Reading accepts any float level set (any
-// name; the first level-set grid when there are several) and says why it refuses
-// anything else.
+// VDB files (the README's "Files" section): one FloatGrid named "surface", class level
+// set, linear transform with the voxel size, background = half-width x voxel size,
+// negative inside, metadata creator / voxel_size / half_width. Reading accepts any float
+// level set (any name; the first level-set grid when there are several) and says why it
+// refuses anything else.
 #pragma once
 
 #include <stdexcept>

@@ -1,10 +1,12 @@
 #include "levelset/advect.h"
-#include "levelset/level_set.h"
+#include "levelset/band.h"
+#include "levelset/local_tree.h"
 #include "levelset/monotone_cubic.h"
 
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <utility>
 #include <vector>
 
 #include <Eigen/SVD>
@@ -29,31 +31,83 @@ double since(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
 
-// Resamples every active voxel of `grid` inside `box` from `source` at map(x), and marks in
-// `changed` the voxels whose value changed (where the deformation is the identity, a sample
-// at a voxel centre returns its value exactly).
+// What sampling reads: the grid as it was before sampling began. Sampling writes only the
+// leaves it resamples, so those are copied first (copy on write) and every other read goes
+// to the live grid, which nothing else changes meanwhile: the cost follows the brush, not
+// the model. Where the band had to be widened, the copies hold the widened band.
+class SampleSource {
+  public:
+    SampleSource(const Grid& live, GridPtr copies) : live_(live), copies_(std::move(copies)) {}
+    // Copies of these leaves (their values before sampling).
+    static std::shared_ptr<SampleSource> copyOnWrite(const Grid& live,
+                                                     const std::vector<LeafNode*>& leaves) {
+        return std::make_shared<SampleSource>(live, copyLeaves(live, leaves));
+    }
+    // A grid holding copies of these leaves, with the live grid's transform and background.
+    template <typename Leaves> static GridPtr copyLeaves(const Grid& live, const Leaves& leaves) {
+        GridPtr copies = Grid::create(live.background());
+        copies->setTransform(live.transform().copy());
+        for (const LeafNode* leaf : leaves)
+            copies->tree().addLeaf(new LeafNode(*leaf));
+        return copies;
+    }
+
+    // One per thread. The interface of a tree accessor that OpenVDB's samplers read.
+    class Accessor {
+      public:
+        using ValueType = float;
+        explicit Accessor(const SampleSource& s)
+            : copies_(s.copies_->getConstAccessor()), live_(s.live_.getConstAccessor()) {}
+        float getValue(const openvdb::Coord& ijk) const {
+            if (const LeafNode* leaf = copy(ijk)) return leaf->getValue(ijk);
+            return live_.getValue(ijk);
+        }
+        bool isValueOn(const openvdb::Coord& ijk) const {
+            if (const LeafNode* leaf = copy(ijk)) return leaf->isValueOn(ijk);
+            return live_.isValueOn(ijk);
+        }
+        bool probeValue(const openvdb::Coord& ijk, float& v) const {
+            if (const LeafNode* leaf = copy(ijk)) return leaf->probeValue(ijk, v);
+            return live_.probeValue(ijk, v);
+        }
+
+      private:
+        const LeafNode* copy(const openvdb::Coord& ijk) const {
+            return copies_.probeConstLeaf(ijk);
+        }
+        Grid::ConstAccessor copies_, live_;
+    };
+
+  private:
+    const Grid& live_;
+    GridPtr copies_;
+};
+
+// Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
+// map(x), and marks in `changed` the voxels whose value changed (where the deformation is
+// the identity, a sample at a voxel centre returns its value exactly).
 template <typename Map>
-std::size_t resample(Grid& grid, const Grid& source, const openvdb::CoordBBox& box, const Map& map,
-                     Sampling sampling, openvdb::MaskGrid& changed, Interrupter* interrupter) {
+std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const SampleSource& source,
+                     const openvdb::CoordBBox& box, const Map& map, Sampling sampling,
+                     openvdb::MaskGrid& changed, Interrupter* interrupter) {
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> marks;
-    openvdb::tree::LeafManager<Grid::TreeType> leaves(grid.tree());
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
-    tbb::parallel_for(leaves.leafRange(), [&](const auto& range) {
-        Grid::ConstAccessor acc = source.getConstAccessor();
-        openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> trilinear(
-            acc, source.transform());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
+        const SampleSource::Accessor acc(source);
         std::size_t n = 0;
         pollInterrupt(interrupter);
-        for (auto leaf = range.begin(); leaf; ++leaf) {
-            if (!box.hasOverlap(leaf->getNodeBoundingBox())) continue;
-            for (auto it = leaf->beginValueOn(); it; ++it) {
+        for (std::size_t l = range.begin(); l != range.end(); ++l) {
+            for (auto it = leaves[l]->beginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
                 if (!box.isInside(ijk)) continue;
-                const openvdb::Vec3d p = toVdb(map(toEigen(xform.indexToWorld(ijk))));
-                const float v = float(sampling == Sampling::Trilinear
-                                          ? trilinear.wsSample(p)
-                                          : sampleMonotoneCubic(acc, source.worldToIndex(p)));
+                const openvdb::Vec3d p =
+                    xform.worldToIndex(toVdb(map(toEigen(xform.indexToWorld(ijk)))));
+                float v = 0.0f;
+                if (sampling == Sampling::Trilinear)
+                    openvdb::tools::BoxSampler::sample(acc, p, v);
+                else
+                    v = float(sampleMonotoneCubic(acc, p));
                 if (v != *it || !acc.isValueOn(ijk)) marks.local().push_back(ijk);
                 it.setValue(v);
                 ++n;
@@ -102,8 +156,10 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     std::vector<openvdb::Coord> interface;
     {
         auto acc = grid.getConstAccessor();
-        for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
-            if (!region.hasOverlap(leaf->getNodeBoundingBox())) continue;
+        const auto leaves = leavesIn(std::as_const(grid.tree()), region);
+        stats.leavesVisited += leaves.size();
+        for (const LeafNode* leaf : leaves) {
+            stats.voxelsVisited += leaf->onVoxelCount();
             for (auto it = leaf->cbeginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
                 if (region.isInside(ijk) && nextToCrossing(acc, ijk, *it)) interface.push_back(ijk);
@@ -158,24 +214,36 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // Make sure the old band reaches that far, so none of them reads a clamped value.
     const double needed = std::ceil(1.5 * std::min(maxStretch, 32.0) + 1.0);
     stats.widenedTo = std::max(halfWidth, needed);
-    GridPtr source;
+    GridPtr widened; // the copies with the widened band, when it had to be widened
     if (needed > halfWidth) {
-        // Only the affected box is sampled, so the band is widened there alone: its active
-        // voxels are dilated in a mask and merged into a copy of the grid, whose inactive
-        // values (now +-needed voxels) carry the signs; fast marching fills in distances.
+        // Only the affected box is sampled, so the band is widened there alone: copies of
+        // its leaves, whose inactive values (now +-needed voxels) carry the signs, take the
+        // band dilated by the missing voxels, and fast marching fills in distances.
         const openvdb::CoordBBox box = indexBox(grid, seg.affectedBox(), int(needed) + 3);
-        source = grid.deepCopy();
+        const auto leaves = leavesIn(std::as_const(grid.tree()), box);
+        GridPtr source = SampleSource::copyLeaves(grid, leaves);
+        stats.leavesCopied += leaves.size();
         openvdb::tools::changeLevelSetBackground(source->tree(), float(needed * h));
         openvdb::MaskGrid::Ptr widen = openvdb::MaskGrid::create();
-        for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf) {
-            if (!box.hasOverlap(leaf->getNodeBoundingBox())) continue;
+        for (const LeafNode* leaf : leaves)
             widen->tree().touchLeaf(leaf->origin())->topologyUnion(*leaf);
-        }
         openvdb::tools::dilateActiveValues(widen->tree(), int(std::ceil(needed - halfWidth)),
                                            openvdb::tools::NN_FACE, openvdb::tools::IGNORE_TILES);
         source->tree().topologyUnion(widen->tree());
+        // Leaves the dilation added hold the copies' background: give each voxel the sign
+        // the live grid has there (a tile of the band's inside or outside).
+        {
+            auto live = grid.getConstAccessor();
+            const float far = float(needed * h);
+            for (LeafNode* leaf : leavesIn(source->tree(), box)) {
+                if (grid.tree().probeConstLeaf(leaf->origin())) continue; // a copy
+                for (auto it = leaf->beginValueAll(); it; ++it)
+                    it.setValue(live.getValue(it.getCoord()) < 0.0f ? -far : far);
+            }
+        }
         renormalize(*source, indexBox(grid, seg.affectedBox(), int(needed) + 1), FmmOrder::First,
                     options.interrupter);
+        widened = source;
     }
     // Voxels the band grows into: renormalized (or dropped again) wherever they are.
     openvdb::MaskGrid::Ptr fresh = mask->deepCopy();
@@ -186,29 +254,50 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // 2. Sample: composed inverse (default) or one resample per sub-step (5.3.4).
     t0 = Clock::now();
     const openvdb::MaskGrid::Ptr changed = openvdb::MaskGrid::create();
-    if (!options.resampleEachSubStep) {
-        if (!source) source = grid.deepCopy();
-        stats.sampledVoxels = resample(
-            grid, *source, region, [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); },
-            options.sampling, *changed, options.interrupter);
-    } else {
-        for (int k = 0; k < seg.steps(); ++k) {
-            GridPtr step = (k == 0 && source) ? source : grid.deepCopy();
-            stats.sampledVoxels += resample(
-                grid, *step, region,
-                [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling,
-                *changed, options.interrupter);
+    const std::vector<LeafNode*> sampled = leavesIn(grid.tree(), region);
+    stats.leavesVisited += sampled.size();
+    if (widened) {
+        // Leaves the band just grew into, outside the widened copies: sampling writes them,
+        // so it must not read them from the live grid; as copies they hold the sign of the
+        // tile they came from, at the widened background.
+        const float far = widened->background();
+        for (const LeafNode* leaf : sampled) {
+            if (widened->tree().probeConstLeaf(leaf->origin())) continue;
+            auto* copy = new LeafNode(*leaf);
+            for (auto it = copy->beginValueAll(); it; ++it)
+                it.setValue(*it < 0.0f ? -far : far);
+            widened->tree().addLeaf(copy);
+            ++stats.leavesCopied;
         }
     }
+    auto source = [&](int k) {
+        if (widened && k == 0) return std::make_shared<SampleSource>(grid, widened);
+        auto copy = SampleSource::copyOnWrite(grid, sampled);
+        stats.leavesCopied += sampled.size();
+        return copy;
+    };
+    if (!options.resampleEachSubStep) {
+        stats.sampledVoxels = resample(
+            grid, sampled, *source(0), region,
+            [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); }, options.sampling, *changed,
+            options.interrupter);
+    } else {
+        for (int k = 0; k < seg.steps(); ++k)
+            stats.sampledVoxels += resample(
+                grid, sampled, *source(k), region,
+                [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling,
+                *changed, options.interrupter);
+    }
+    stats.voxelsVisited += stats.sampledVoxels;
     // Voxels inside the region that are not in the band kept their old inactive values,
     // whose signs may now be wrong (space pulled out of the shape is inside it now):
-    // re-derive every inactive sign from the band.
-    openvdb::tools::signedFloodFill(grid.tree());
+    // re-derive the inactive signs there (and in the band grown around it) from the band.
+    const openvdb::CoordBBox touched = changedRegion(grid, seg);
+    stats.leavesFlooded = floodSignsIn(grid.tree(), touched);
     stats.sampleSeconds = since(t0);
 
     // 3. Renormalize the changed region (and the band around it).
     t0 = Clock::now();
-    const openvdb::CoordBBox touched = changedRegion(grid, seg);
     if (options.renormalize) {
         // Only where values changed, and as far as the band reaches from there (the nearest
         // surface of a voxel nearby may have moved): where the deformation is the identity
@@ -217,7 +306,10 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                                            openvdb::tools::NN_FACE_EDGE_VERTEX,
                                            openvdb::tools::IGNORE_TILES);
         changed->tree().topologyUnion(fresh->tree());
-        renormalize(grid, touched, *changed, options.renormalization, options.interrupter);
+        const FmmStats fmm =
+            renormalize(grid, touched, *changed, options.renormalization, options.interrupter);
+        stats.leavesVisited += fmm.leaves;
+        stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
     }
     stats.renormalizeSeconds = since(t0);
     stats.touched = touched;

@@ -39,6 +39,12 @@ struct AdvectStats {
     std::size_t interfaceVoxels = 0; // forward-mapped to grow the band
     std::size_t sampledVoxels = 0;
     double widenedTo = 0.0; // band half-width used for sampling, in voxels
+    // The work, counted: what a segment reads and writes follows the brush, never the
+    // size of the model (the same stroke counts the same on a grid holding more shapes).
+    std::size_t voxelsVisited = 0; // scanned for the interface, sampled, marched over
+    std::size_t leavesVisited = 0; // leaves those loops went through
+    std::size_t leavesCopied = 0;  // copied as the sampling source
+    std::size_t leavesFlooded = 0; // whose inactive signs were re-derived
     double growSeconds = 0.0, sampleSeconds = 0.0, renormalizeSeconds = 0.0;
     openvdb::CoordBBox touched; // index box whose values may have changed
 };

@@ -13,6 +13,8 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
+#include "levelset/local_tree.h"
+
 namespace sweepers {
 
 namespace {
@@ -37,8 +39,7 @@ class Domain {
            const openvdb::MaskGrid* only) {
         openvdb::CoordBBox outer = region;
         outer.expand(margin);
-        for (auto it = grid.tree().beginLeaf(); it; ++it)
-            if (outer.hasOverlap(it->getNodeBoundingBox())) leaves_.push_back(&*it);
+        leaves_ = leavesIn(grid.tree(), outer);
         std::unordered_map<openvdb::Coord, int> index;
         for (std::size_t l = 0; l < leaves_.size(); ++l)
             index[leaves_[l]->origin()] = int(l);
@@ -344,7 +345,10 @@ FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
             }
         }
     });
-    openvdb::tools::pruneLevelSet(grid.tree());
+    openvdb::CoordBBox written = region;
+    written.expand(2);
+    pruneEmptyLeavesIn(grid.tree(), written);
+    stats.leaves = b.leafCount();
     return stats;
 }
 } // namespace
@@ -353,7 +357,9 @@ FmmStats renormalizeAll(Grid& grid, FmmOrder order, Interrupter* interrupter) {
     openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
     if (box.empty()) return {};
     box.expand(2);
-    return renormalize(grid, box, order, interrupter);
+    const FmmStats stats = renormalize(grid, box, order, interrupter);
+    openvdb::tools::pruneLevelSet(grid.tree()); // the whole grid: its internal nodes too
+    return stats;
 }
 
 } // namespace sweepers

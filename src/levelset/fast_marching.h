@@ -26,6 +26,7 @@ enum class FmmOrder { First = 1, Second = 2 };
 struct FmmStats {
     std::size_t seeds = 0;
     std::size_t marched = 0; // voxels accepted by the march (seeds excluded)
+    std::size_t leaves = 0;  // leaves of the domain (overlapping the region and its margin)
 };
 
 // Recomputes the distances of the voxels inside `region` (index space). The result is a

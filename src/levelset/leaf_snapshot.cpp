@@ -2,13 +2,12 @@
 
 #include <openvdb/tools/SignedFloodFill.h>
 
+#include "levelset/stencils.h"
+
 namespace sweepers {
 
 namespace {
 constexpr int kDim = int(Grid::TreeType::LeafNodeType::DIM);
-int floorToBlock(int v) {
-    return v >= 0 ? v / kDim * kDim : -((-v + kDim - 1) / kDim) * kDim;
-}
 } // namespace
 
 void LeafSnapshot::captureBlock(const Grid& grid, const openvdb::Coord& origin) {
@@ -25,9 +24,10 @@ void LeafSnapshot::captureBlock(const Grid& grid, const openvdb::Coord& origin) 
 
 void LeafSnapshot::capture(const Grid& grid, const openvdb::CoordBBox& box) {
     if (box.empty()) return;
-    for (int x = floorToBlock(box.min().x()); x <= box.max().x(); x += kDim)
-        for (int y = floorToBlock(box.min().y()); y <= box.max().y(); y += kDim)
-            for (int z = floorToBlock(box.min().z()); z <= box.max().z(); z += kDim)
+    const openvdb::Coord first = floorToMultiple(box.min(), kDim);
+    for (int x = first.x(); x <= box.max().x(); x += kDim)
+        for (int y = first.y(); y <= box.max().y(); y += kDim)
+            for (int z = first.z(); z <= box.max().z(); z += kDim)
                 captureBlock(grid, openvdb::Coord(x, y, z));
 }
 

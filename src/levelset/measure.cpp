@@ -5,7 +5,8 @@
 #include <openvdb/tree/LeafManager.h>
 #include <tbb/parallel_reduce.h>
 
-#include "levelset/level_set.h"
+#include "levelset/band.h"
+#include "levelset/stencils.h"
 
 namespace sweepers {
 
@@ -44,8 +45,7 @@ int topologicalEulerCharacteristic(const Grid& grid) {
                     const openvdb::Coord base = it.getCoord();
                     int in = 0; // bit (dx + 2 dy + 4 dz)
                     for (int c = 0; c < 8; ++c)
-                        if (acc.getValue(base.offsetBy(c & 1, c >> 1 & 1, c >> 2 & 1)) < 0.0f)
-                            in |= 1 << c;
+                        if (acc.getValue(cubeCorner(base, c)) < 0.0f) in |= 1 << c;
                     if (in == 0 || in == 255) continue;
                     long v = 8;
                     for (int a = 0; a < 3; ++a)

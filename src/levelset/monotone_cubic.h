@@ -34,7 +34,8 @@ inline double monotoneCubic(double fm, double f0, double f1, double f2, double t
 
 // Tricubic sample of the grid at an index-space position: the 1D interpolant along x on
 // the 16 rows of the 4x4x4 neighbourhood, then along y, then z.
-inline double sampleMonotoneCubic(const Grid::ConstAccessor& acc, const openvdb::Vec3d& x) {
+template <typename Accessor>
+double sampleMonotoneCubic(const Accessor& acc, const openvdb::Vec3d& x) {
     const openvdb::Coord base = openvdb::Coord::floor(x);
     const double tx = x.x() - base.x(), ty = x.y() - base.y(), tz = x.z() - base.z();
     double plane[4];

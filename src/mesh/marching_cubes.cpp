@@ -5,6 +5,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "levelset/local_tree.h"
+#include "levelset/stencils.h"
 #include "mesh/mc_table.h"
 
 namespace sweepers {
@@ -26,22 +28,13 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
     const auto& xform = grid.transform();
     const double h = grid.voxelSize()[0];
     std::unordered_map<std::uint64_t, int> vertexOf;
-    auto gradient = [&](const openvdb::Coord& c) {
-        Eigen::Vector3f g;
-        for (int a = 0; a < 3; ++a) {
-            openvdb::Coord lo = c, hi = c;
-            lo[a] -= 1;
-            hi[a] += 1;
-            g[a] = float((acc.getValue(hi) - acc.getValue(lo)) / (2 * h));
-        }
-        return g;
-    };
+    auto gradient = [&](const openvdb::Coord& c) { return centralGradient(acc, c, h); };
     for (auto it = leaf->cbeginValueOn(); it; ++it) {
         const openvdb::Coord base = it.getCoord();
         float v[8];
         int mask = 0;
         for (int c = 0; c < 8; ++c) {
-            v[c] = acc.getValue(base.offsetBy(c & 1, c >> 1 & 1, c >> 2 & 1));
+            v[c] = acc.getValue(cubeCorner(base, c));
             if (v[c] < 0.0f) mask |= 1 << c;
         }
         if (mask == 0 || mask == 255) continue;
@@ -136,15 +129,17 @@ std::size_t SurfaceMesher::update(const Grid& grid, const openvdb::CoordBBox& to
     openvdb::CoordBBox box = touched;
     box.expand(1);
     changes_.box.expand(box);
-    // Forget every chunk whose leaf overlaps the box, then mesh the leaves there now.
-    for (auto it = chunks_.begin(); it != chunks_.end();) {
-        const openvdb::CoordBBox leafBox =
-            openvdb::CoordBBox::createCube(it->first, Grid::TreeType::LeafNodeType::DIM);
-        it = box.hasOverlap(leafBox) ? chunks_.erase(it) : std::next(it);
-    }
+    // Forget every chunk whose leaf overlaps the box (they are keyed by leaf origin: visit
+    // the box leaf by leaf), then mesh the leaves there now.
+    constexpr int kDim = int(LeafNode::DIM);
+    const openvdb::Coord first = floorToMultiple(box.min(), kDim);
+    for (int x = first.x(); x <= box.max().x(); x += kDim)
+        for (int y = first.y(); y <= box.max().y(); y += kDim)
+            for (int z = first.z(); z <= box.max().z(); z += kDim)
+                chunks_.erase(openvdb::Coord(x, y, z));
     std::vector<openvdb::Coord> origins;
-    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
-        if (box.hasOverlap(leaf->getNodeBoundingBox())) origins.push_back(leaf->origin());
+    for (const LeafNode* leaf : leavesIn(std::as_const(grid.tree()), box))
+        origins.push_back(leaf->origin());
     meshLeaves(grid, origins);
     return origins.size();
 }

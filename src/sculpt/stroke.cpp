@@ -1,7 +1,7 @@
 #include "sculpt/stroke.h"
 
 #include "deform/inflate.h"
-#include "levelset/level_set.h"
+#include "levelset/band.h"
 #include "tools/ellipsoid.h"
 
 namespace sweepers {
@@ -44,7 +44,9 @@ std::size_t segmentCount(const Stroke& stroke) {
 std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke) {
     // Planned when the stroke comes: an inflation's reach is the shape as it is then.
     std::vector<std::unique_ptr<StepDeformation>> parts;
-    const Box reach = activeWorldBox(grid).expanded(2 * grid.voxelSize()[0]);
+    // A swirl carrying a ball and an inflation reach the whole shape (found by walking the
+    // grid: only for those two).
+    auto reach = [&] { return activeWorldBox(grid).expanded(2 * grid.voxelSize()[0]); };
     std::visit(Overloaded{
                    [&](const SweepStroke& s) {
                        const Sweep sweep = toSweep(s);
@@ -53,12 +55,12 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                    },
                    [&](const SwirlStroke& s) {
                        if (s.ball > 0.0)
-                           parts.push_back(starShapedSwirl(toSwirl(s), s.ball, reach));
+                           parts.push_back(starShapedSwirl(toSwirl(s), s.ball, reach()));
                        else
                            parts.push_back(std::make_unique<SwirlSegment>(toSwirl(s)));
                    },
                    [&](const InflateStroke& s) {
-                       parts.push_back(std::make_unique<Inflation>(s.at, s.radius, reach));
+                       parts.push_back(std::make_unique<Inflation>(s.at, s.radius, reach()));
                    },
                },
                stroke);

@@ -13,6 +13,8 @@ trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
 run() { "$app" --size 640x480 "$@"; }
 echo '{"events": []}' >"$tmp/none.json"
+[ "$("$app" --version)" = "sweepers $("$cli" --version | cut -d' ' -f2)" ] ||
+  fail "sweepers --version: '$("$app" --version)'"
 
 # --- the default scene: a sphere in the middle -----------------------------------------
 run --hide-ui --screenshot "$tmp/default.png" --replay-input "$tmp/none.json" --save "$tmp/default.vdb"

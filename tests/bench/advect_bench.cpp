@@ -14,7 +14,7 @@
 #include "core/falloff.h"
 #include "deform/sweep.h"
 #include "levelset/advect.h"
-#include "levelset/level_set.h"
+#include "levelset/create.h"
 #include "tools/ellipsoid.h"
 
 namespace sweepers::bench {

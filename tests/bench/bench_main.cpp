@@ -19,7 +19,8 @@
 #include "bench.h"
 #include "deform/sweep.h"
 #include "levelset/advect.h"
-#include "levelset/level_set.h"
+#include "levelset/band.h"
+#include "levelset/create.h"
 #include "tools/ellipsoid.h"
 
 namespace sweepers::bench {

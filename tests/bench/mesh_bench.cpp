@@ -1,7 +1,7 @@
 // Meshing: our marching cubes (every leaf, welded into one mesh, as for export) against
 // tools::volumeToMesh (dual contouring without adaptivity), on the same grids.
 #include "bench.h"
-#include "levelset/level_set.h"
+#include "levelset/create.h"
 #include "mesh/marching_cubes.h"
 
 namespace sweepers::bench {

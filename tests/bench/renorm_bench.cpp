@@ -13,8 +13,8 @@
 #include <openvdb/tools/LevelSetTracker.h>
 
 #include "bench.h"
+#include "levelset/create.h"
 #include "levelset/fast_marching.h"
-#include "levelset/level_set.h"
 #include "mesh/marching_cubes.h"
 
 namespace sweepers::bench {

@@ -5,7 +5,7 @@
 
 #include <openvdb/tools/SignedFloodFill.h>
 
-#include "levelset/level_set.h"
+#include "levelset/create.h"
 
 namespace sweepers::test {
 

@@ -4,16 +4,19 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <openvdb/tools/Composite.h>
 
 #include "deform/inflate.h"
 #include "io/start_grid.h"
 #include "io/stroke_script.h"
 #include "levelset/advect.h"
-#include "levelset/level_set.h"
+#include "levelset/band.h"
+#include "levelset/create.h"
 #include "levelset/measure.h"
 #include "levelset/monotone_cubic.h"
 #include "mesh/marching_cubes.h"
 #include "replay.h"
+#include "sculpt/sculptor.h"
 #include "tools/ellipsoid.h"
 
 using namespace sweepers;
@@ -152,4 +155,48 @@ TEST(Advect, InflationAddsTheBallInsideAndKeepsVolumeOutside) {
         }
         EXPECT_TRUE(meshTopology(mesh).watertight());
     }
+}
+
+TEST(Advect, ASegmentsWorkFollowsTheBrushNotTheModel) {
+    // The same three-segment pull on the unit sphere, alone and in a grid that also holds a
+    // sphere of radius 4 ten units away: every count of work is the same, and so is the
+    // result near the brush.
+    const double h = 1.0 / 64;
+    const GridPtr alone = makeSphere({0, 0, 0}, 1.0, h, 3.0);
+    GridPtr both = alone->deepCopy();
+    openvdb::tools::csgUnion(both->tree(), makeSphere({10, 0, 0}, 4.0, h, 3.0)->tree());
+    ASSERT_GT(both->tree().leafCount(), 10 * alone->tree().leafCount());
+    const Sweep sweep{
+        {{std::make_shared<EllipsoidShape>(0.25),
+          0.25,
+          {at({0, 0.95, 0}), at({0.1, 1.15, 0}), at({0.2, 1.3, 0}), at({0.2, 1.45, 0.1})}}}};
+    Sculptor small(alone), large(both);
+    small.startMeshing();
+    large.startMeshing();
+    for (std::size_t k = 0; k < sweep.segmentCount(); ++k) {
+        const SweepSegment segment(sweep, k);
+        const SegmentReport a = small.applySegment(segment), b = large.applySegment(segment);
+        std::printf("[ work ] segment %zu: %zu voxels and %zu leaves visited, %zu leaves "
+                    "copied, %zu flooded, %zu re-meshed (model of %zu or %zu leaves)\n",
+                    k, a.stats.voxelsVisited, a.stats.leavesVisited, a.stats.leavesCopied,
+                    a.stats.leavesFlooded, a.remeshedLeaves,
+                    std::size_t(small.grid().tree().leafCount()),
+                    std::size_t(large.grid().tree().leafCount()));
+        EXPECT_GT(a.stats.voxelsVisited, 0u);
+        EXPECT_GT(a.stats.leavesCopied, 0u);
+        EXPECT_GT(a.stats.leavesFlooded, 0u);
+        EXPECT_EQ(a.stats.voxelsVisited, b.stats.voxelsVisited) << "segment " << k;
+        EXPECT_EQ(a.stats.leavesVisited, b.stats.leavesVisited) << "segment " << k;
+        EXPECT_EQ(a.stats.leavesCopied, b.stats.leavesCopied) << "segment " << k;
+        EXPECT_EQ(a.stats.leavesFlooded, b.stats.leavesFlooded) << "segment " << k;
+        EXPECT_EQ(a.remeshedLeaves, b.remeshedLeaves) << "segment " << k;
+    }
+    // Near the brush (the unit sphere's box) the two grids hold the same values.
+    auto ca = small.grid().getConstAccessor();
+    auto cb = large.grid().getConstAccessor();
+    std::size_t differing = 0;
+    const openvdb::CoordBBox box = small.grid().evalActiveVoxelBoundingBox();
+    for (auto it = box.begin(); it; ++it)
+        differing += ca.getValue(*it) != cb.getValue(*it);
+    EXPECT_EQ(differing, 0u);
 }

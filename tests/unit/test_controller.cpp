@@ -2,13 +2,16 @@
 // twists keep the hand's direction, and long work can be cancelled, leaving the document
 // and the mesh as they were.
 #include <cmath>
+#include <filesystem>
 
 #include <gtest/gtest.h>
 
 #include "app/sculpt_controller.h"
 #include "grids.h"
+#include "io/stroke_script.h"
+#include "levelset/create.h"
 #include "levelset/fast_marching.h"
-#include "levelset/level_set.h"
+#include "replay.h"
 
 using namespace sweepers;
 using sweepers::test::differingVoxels;
@@ -105,6 +108,39 @@ TEST(SculptController, AFastTwistTurnsTheWayTheHandWent) {
         EXPECT_GT(a, 10.0);
         EXPECT_NEAR(b, a, 0.02 * a);
     }
+}
+
+TEST(SculptController, EveryReplayFileSculptsAndRecordsAScriptThatReplaysExactly) {
+    // The modeler's own test input, without a window: every file sculpts something, and
+    // the recorded script, applied as sweepers-cli applies it, gives the same grid.
+    std::size_t files = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(SWEEPERS_APP_TEST_DIR)) {
+        if (entry.path().extension() != ".json") continue;
+        std::vector<InputEvent> events;
+        try {
+            events = readInputEvents(entry.path().string());
+        } catch (const std::exception&) {
+            continue; // a stroke script, not events
+        }
+        ++files;
+        const std::string name = entry.path().filename().string();
+        Document doc(Document::sphereScript(1.0 / 32), ".");
+        SculptController ctl(/*waitEachPiece=*/true);
+        ctl.setViewport(kWidth, kHeight);
+        ctl.setDocument(&doc);
+        ctl.frameView();
+        const GridPtr before = doc.grid().deepCopy();
+        replayEvents(ctl, events);
+        doc.endEdit();
+        EXPECT_EQ(ctl.takeMessage(), "") << name;
+        ASSERT_FALSE(doc.script().strokes.empty()) << name;
+        EXPECT_GT(differingVoxels(*before, doc.grid()), 100u) << name;
+        const StrokeScript recorded =
+            parseStrokeScript(formatStrokeScript(doc.script()), "recorded " + name);
+        EXPECT_EQ(differingVoxels(*applyScript(recorded, "."), doc.grid()), 0u) << name;
+        std::printf("[ replay ] %s: %zu strokes\n", name.c_str(), doc.script().strokes.size());
+    }
+    EXPECT_GE(files, 4u);
 }
 
 TEST(SculptController, EscapeCancelsTheDragAndPutsTheShapeBack) {

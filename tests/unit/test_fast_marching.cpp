@@ -5,6 +5,7 @@
 #include <openvdb/tools/LevelSetMeasure.h>
 
 #include "grids.h"
+#include "levelset/band.h"
 #include "levelset/fast_marching.h"
 
 using namespace sweepers;

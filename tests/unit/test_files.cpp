@@ -8,7 +8,8 @@
 
 #include "io/mesh_file.h"
 #include "io/vdb_file.h"
-#include "levelset/level_set.h"
+#include "levelset/band.h"
+#include "levelset/create.h"
 #include "mesh/marching_cubes.h"
 #include "scratch_dir.h"
 

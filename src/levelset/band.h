@@ -1,0 +1,33 @@
+// Measuring a level set as a narrow band: where it crosses zero, how much of it is a true
+// distance, and the box it covers.
+#pragma once
+
+#include <string>
+
+#include "core/box.h"
+#include "levelset/vdb.h"
+
+namespace sweepers {
+
+// True when a face neighbour of voxel ijk (value v) lies on the other side of the surface:
+// the voxel is next to the zero crossing.
+bool nextToCrossing(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk, float v);
+
+struct BandReport {
+    std::size_t activeVoxels = 0;
+    std::size_t nearInterface = 0; // active voxels within one voxel of the zero crossing
+    std::size_t unitGradient = 0;  // ... of which |grad phi| lies in [0.9, 1.1]
+    std::size_t beyondBand = 0;    // active voxels with |phi| > half-width + 1 voxel
+    std::string vdbCheck;          // tools::checkLevelSet's complaint, empty when none
+    double unitGradientFraction() const {
+        return nearInterface ? double(unitGradient) / double(nearInterface) : 1.0;
+    }
+};
+
+// Measures how well the grid is a narrow-band signed distance field.
+BandReport checkBand(const Grid& grid);
+
+// World-space box of the active voxels.
+Box activeWorldBox(const Grid& grid);
+
+} // namespace sweepers

@@ -1,0 +1,72 @@
+// Work on the part of a tree inside an index box, at a cost that follows the box, not the
+// tree: a sculpting segment touches a brush-sized box of a model that only grows.
+//
+// The leaves overlapping a box are found by descending the tree through the internal
+// nodes that overlap it; signs of inactive values are re-derived (signed flood fill) in the
+// leaves and internal nodes overlapping the box, bottom up; leaves left without an active
+// voxel are replaced by tiles.
+#pragma once
+
+#include <cstddef>
+#include <type_traits>
+#include <vector>
+
+#include <openvdb/tools/SignedFloodFill.h>
+
+#include "levelset/vdb.h"
+
+namespace sweepers {
+
+using LeafNode = Grid::TreeType::LeafNodeType;
+
+// The leaves of `tree` (a Grid::TreeType, const or not) overlapping `box`.
+template <typename TreeT> auto leavesIn(TreeT& tree, const openvdb::CoordBBox& box) {
+    using Leaf = std::conditional_t<std::is_const_v<TreeT>, const LeafNode, LeafNode>;
+    std::vector<Leaf*> out;
+    if (box.empty()) return out;
+    for (auto upper = tree.root().beginChildOn(); upper; ++upper) {
+        if (!box.hasOverlap(upper->getNodeBoundingBox())) continue;
+        for (auto lower = upper->beginChildOn(); lower; ++lower) {
+            if (!box.hasOverlap(lower->getNodeBoundingBox())) continue;
+            for (auto leaf = lower->beginChildOn(); leaf; ++leaf)
+                if (box.hasOverlap(leaf->getNodeBoundingBox())) out.push_back(&*leaf);
+        }
+    }
+    return out;
+}
+
+// Re-derives the signs of the inactive values in the leaves and internal nodes that
+// overlap `box` (what tools::signedFloodFill does to a whole tree), from their active
+// values; everything outside keeps its values. Returns the number of leaves filled.
+inline std::size_t floodSignsIn(Grid::TreeType& tree, const openvdb::CoordBBox& box) {
+    if (box.empty()) return 0;
+    const openvdb::tools::SignedFloodFillOp<Grid::TreeType> fill(tree);
+    std::size_t nodes = 0;
+    for (auto upper = tree.root().beginChildOn(); upper; ++upper) {
+        if (!box.hasOverlap(upper->getNodeBoundingBox())) continue;
+        for (auto lower = upper->beginChildOn(); lower; ++lower) {
+            if (!box.hasOverlap(lower->getNodeBoundingBox())) continue;
+            for (auto leaf = lower->beginChildOn(); leaf; ++leaf)
+                if (box.hasOverlap(leaf->getNodeBoundingBox())) {
+                    fill(*leaf);
+                    ++nodes;
+                }
+            fill(*lower); // its tiles, from its children's signs
+        }
+        fill(*upper);
+    }
+    fill(tree.root()); // the root's tiles between its (few) children
+    return nodes;
+}
+
+// Replaces the leaves overlapping `box` that hold no active voxel by tiles of their sign.
+inline void pruneEmptyLeavesIn(Grid::TreeType& tree, const openvdb::CoordBBox& box) {
+    const float background = tree.background();
+    for (LeafNode* leaf : leavesIn(tree, box)) {
+        if (!leaf->isEmpty()) continue;
+        const float value = leaf->getFirstValue() < 0.0f ? -background : background;
+        tree.addTile(1, leaf->origin(), value, false); // level 1: one leaf-sized tile
+    }
+}
+
+} // namespace sweepers
