@@ -252,6 +252,7 @@ int main(int argc, char** argv) {
     if (benchmark::ReportUnrecognizedArguments(n, rest.data())) return 2;
 
     registerDragBenchmarks(); // first: its peak memory is then its own
+    registerScaleBenchmarks();
     registerAdvectBenchmarks();
     registerRenormalizeBenchmarks();
     registerMeshBenchmarks();

@@ -2,9 +2,15 @@
 // ball tool of radius 0.25 on the unit sphere, replayed as the modeler does it (advect,
 // renormalize, re-mesh the touched leaves after every segment). Reports the latency of a
 // segment, p50 and p95, split by stage, and the process's peak memory.
+//
+// The scale group: the first 20 segments of the same drag at voxel size 1/128 on spheres
+// of radius 1, 2 and 4 (the drag moved out to the surface): a segment must cost what the
+// brush touches, not what the model holds.
 #include <sys/resource.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <fstream>
 
 #include "bench.h"
 #include "core/statistics.h"
@@ -13,6 +19,71 @@
 #include "sculpt/sculptor.h"
 
 namespace sweepers::bench {
+namespace {
+
+// Per-segment figures of a run: p50 and p95 of the whole segment and p50 of each stage.
+void addSegmentCounters(benchmark::State& state, const std::vector<SegmentReport>& reports) {
+    std::vector<double> total, advect, renorm, mesh;
+    for (const SegmentReport& r : reports) {
+        total.push_back(1e3 * (r.seconds + r.meshSeconds));
+        advect.push_back(1e3 * (r.stats.growSeconds + r.stats.sampleSeconds));
+        renorm.push_back(1e3 * r.stats.renormalizeSeconds);
+        mesh.push_back(1e3 * r.meshSeconds);
+    }
+    for (const auto& [name, v] : {std::pair{"segment", &total},
+                                  {"advect", &advect},
+                                  {"renorm", &renorm},
+                                  {"mesh", &mesh}}) {
+        state.counters[std::string(name) + "_p50_ms"] = percentile(*v, 0.5);
+        state.counters[std::string(name) + "_p95_ms"] = percentile(*v, 0.95);
+    }
+    state.counters["segments"] = double(reports.size());
+}
+
+// Resident memory now (the peak of the process only grows, so it cannot tell the runs of
+// a group apart).
+double residentMegabytes() {
+    std::ifstream statm("/proc/self/statm");
+    double pages = 0, resident = 0;
+    statm >> pages >> resident;
+    return resident * double(sysconf(_SC_PAGESIZE)) / (1 << 20);
+}
+
+} // namespace
+
+void registerScaleBenchmarks() {
+    for (const int radius : {1, 2, 4}) {
+        add(
+            "scale/drag20_r" + std::to_string(radius) + "_h128/sweepers",
+            [radius](benchmark::State& state) {
+                StrokeScript script =
+                    readStrokeScript(std::string(SWEEPERS_DATA_DIR) + "/drag.json");
+                script.start.radius = radius;
+                auto& sweep = std::get<SweepStroke>(script.strokes.at(0));
+                auto& path = sweep.tools.at(0).path;
+                path.resize(21);
+                for (Placement& p : path)
+                    p.t.z() += radius - 1.0; // the drag runs over the front of the sphere
+                std::vector<SegmentReport> reports;
+                GridPtr grid;
+                double rss = 0.0;
+                for (auto _ : state) {
+                    state.PauseTiming();
+                    grid = makeStartGrid(script, SWEEPERS_DATA_DIR, 1.0 / 128);
+                    Sculptor sculptor(grid);
+                    sculptor.startMeshing();
+                    state.ResumeTiming();
+                    reports = applyStrokes(sculptor, script.strokes);
+                    rss = residentMegabytes();
+                }
+                addSegmentCounters(state, reports);
+                state.counters["active_voxels"] = double(grid->activeVoxelCount());
+                state.counters["rss_mb"] = rss;
+            },
+            1);
+    }
+}
+
 void registerDragBenchmarks() {
     for (const int div : voxelDivisions()) {
         add(
@@ -30,21 +101,7 @@ void registerDragBenchmarks() {
                     state.ResumeTiming();
                     reports = applyStrokes(sculptor, script.strokes);
                 }
-                std::vector<double> total, advect, renorm, mesh;
-                for (const SegmentReport& r : reports) {
-                    total.push_back(1e3 * (r.seconds + r.meshSeconds));
-                    advect.push_back(1e3 * (r.stats.growSeconds + r.stats.sampleSeconds));
-                    renorm.push_back(1e3 * r.stats.renormalizeSeconds);
-                    mesh.push_back(1e3 * r.meshSeconds);
-                }
-                for (const auto& [name, v] : {std::pair{"segment", &total},
-                                              {"advect", &advect},
-                                              {"renorm", &renorm},
-                                              {"mesh", &mesh}}) {
-                    state.counters[std::string(name) + "_p50_ms"] = percentile(*v, 0.5);
-                    state.counters[std::string(name) + "_p95_ms"] = percentile(*v, 0.95);
-                }
-                state.counters["segments"] = double(reports.size());
+                addSegmentCounters(state, reports);
                 state.counters["active_voxels"] = double(grid->activeVoxelCount());
                 rusage usage{};
                 getrusage(RUSAGE_SELF, &usage);
