@@ -310,8 +310,11 @@ FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
                         update(j);
                 }
         };
+        // The first trial values: every far voxel of this side next to a known or fixed one
+        // (the values and the heap that updating the neighbours of every known voxel gives,
+        // without visiting all the fixed voxels around the region).
         for (std::size_t i = 0; i < n; ++i)
-            if (negative(b.phi[i]) == side && state[i] >= Known) updateNeighbours(i);
+            if (state[i] == Far && negative(b.phi[i]) == side) update(i);
         while (!heap.empty()) {
             const auto [v, i] = heap.top();
             heap.pop();
