@@ -27,6 +27,7 @@
 #include "app/input_replay.h"
 #include "app/sculpt_controller.h"
 #include "core/statistics.h"
+#include "core/stopwatch.h"
 #include "io/atomic_file.h"
 #include "io/mesh_file.h"
 #include "levelset/band.h"
@@ -39,8 +40,6 @@ namespace {
 // render thread. What input does to the document and the camera is the controller's.
 class Modeler {
   public:
-    using Clock = std::chrono::steady_clock;
-
     Modeler(const ModelerOptions& o, GLFWwindow* w)
         : batch_(!o.replayInput.empty() || !o.screenshot.empty()), ctl_(batch_ && !o.replayLive),
           opt_(o), win_(w) {
@@ -93,14 +92,13 @@ class Modeler {
                 glFinish();
                 const auto now = Clock::now();
                 const SegmentReport& r = finished_.report;
-                latencies_.push_back(
-                    {1e3 * (r.stats.growSeconds + r.stats.sampleSeconds),
-                     1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds, uploadMs_,
-                     1e3 * std::chrono::duration<double>(now - drawStart).count(),
-                     1e3 * std::chrono::duration<double>(now - finished_.since).count()});
+                latencies_.push_back({1e3 * (r.stats.growSeconds + r.stats.sampleSeconds),
+                                      1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds,
+                                      uploadMs_, 1e3 * secondsSince(drawStart, now),
+                                      1e3 * secondsSince(finished_.since, now)});
                 measuring_ = false;
             }
-            frameMs_ = 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
+            frameMs_ = 1e3 * secondsSince(t0);
             if (ctl_.drag() == DragKind::None && !ctl_.busy() && !job_)
                 idleFrames_.push_back(frameMs_);
             if (!batch_ && glfwWindowShouldClose(win_) && !ctl_.busy() && doc_->modified() &&
@@ -283,7 +281,7 @@ class Modeler {
         if (!ctl_.busy()) {
             const auto t0 = Clock::now();
             renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
-            uploadMs_ = 1e3 * std::chrono::duration<double>(Clock::now() - t0).count();
+            uploadMs_ = 1e3 * secondsSince(t0);
             groundY_ = activeWorldBox(doc_->grid()).min.y();
             info_ = {doc_->grid().voxelSize()[0], std::size_t(doc_->grid().activeVoxelCount()),
                      doc_->mesher().triangleCount(), doc_->undoCount(), doc_->undoBytes()};

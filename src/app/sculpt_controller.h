@@ -18,6 +18,7 @@
 #include "app/camera.h"
 #include "app/document.h"
 #include "app/input_replay.h"
+#include "core/stopwatch.h"
 #include "levelset/interrupt.h"
 
 namespace sweepers {
@@ -40,8 +41,6 @@ enum class KeyAction { None, Save, Cancel };
 
 class SculptController {
   public:
-    using Clock = std::chrono::steady_clock;
-
     // Twist drags are cut into placements at most this far apart, so that every segment
     // turns the way the hand went, however fast it went (a segment's motion is the
     // logarithm of the relative placement, which takes the short way round).

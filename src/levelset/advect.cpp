@@ -1,4 +1,5 @@
 #include "levelset/advect.h"
+#include "core/stopwatch.h"
 #include "levelset/band.h"
 #include "levelset/local_tree.h"
 #include "levelset/monotone_cubic.h"
@@ -22,14 +23,9 @@ namespace sweepers {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 // The stretch of the inverse map varies smoothly along the surface: measuring it at one
 // interface voxel in four finds its maximum to within the margin the widening adds.
 constexpr std::size_t kStretchSampling = 4;
-double since(Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 // What sampling reads: the grid as it was before sampling began. Sampling writes only the
 // leaves it resamples, so those are copied first (copy on write) and every other read goes
@@ -249,7 +245,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     openvdb::MaskGrid::Ptr fresh = mask->deepCopy();
     fresh->tree().topologyDifference(grid.tree());
     grid.tree().topologyUnion(mask->tree());
-    stats.growSeconds = since(t0);
+    stats.growSeconds = secondsSince(t0);
 
     // 2. Sample: composed inverse (default) or one resample per sub-step (5.3.4).
     t0 = Clock::now();
@@ -294,7 +290,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // re-derive the inactive signs there (and in the band grown around it) from the band.
     const openvdb::CoordBBox touched = changedRegion(grid, seg);
     stats.leavesFlooded = floodSignsIn(grid.tree(), touched);
-    stats.sampleSeconds = since(t0);
+    stats.sampleSeconds = secondsSince(t0);
 
     // 3. Renormalize the changed region (and the band around it).
     t0 = Clock::now();
@@ -311,7 +307,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         stats.leavesVisited += fmm.leaves;
         stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
     }
-    stats.renormalizeSeconds = since(t0);
+    stats.renormalizeSeconds = secondsSince(t0);
     stats.touched = touched;
     return stats;
 }

@@ -1,15 +1,8 @@
 #include "sculpt/sculptor.h"
 
-#include <chrono>
+#include "core/stopwatch.h"
 
 namespace sweepers {
-
-namespace {
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-}
-} // namespace
 
 Sculptor::Sculptor(GridPtr grid, AdvectOptions options)
     : grid_(std::move(grid)), options_(options) {}
@@ -44,11 +37,11 @@ SegmentReport Sculptor::applySegment(const StepDeformation& deformation) {
     SegmentReport r;
     const auto t0 = Clock::now();
     r.stats = advectSegment(*grid_, deformation, options_);
-    r.seconds = since(t0);
+    r.seconds = secondsSince(t0);
     if (meshing_) {
         const auto t1 = Clock::now();
         r.remeshedLeaves = mesher_.update(*grid_, r.stats.touched);
-        r.meshSeconds = since(t1);
+        r.meshSeconds = secondsSince(t1);
     }
     return r;
 }
