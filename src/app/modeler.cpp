@@ -59,33 +59,26 @@ class Modeler {
     }
 
     int run() {
-        std::vector<InputEvent> events;
-        if (!opt_.replayInput.empty()) events = readInputEvents(opt_.replayInput);
-        const int lastFrame = events.empty() ? 1 : events.back().frame + 2;
-        std::size_t next = 0;
-        // Replayed events count frames in which no long job runs, as a user waits for one;
-        // the controller says when the next frame's events may come (see replayEvents).
-        int eventFrame = 0;
+        // Replayed events count frames in which no long job runs, as a user waits for one.
+        ReplayClock replay(opt_.replayInput.empty() ? std::vector<InputEvent>{}
+                                                    : readInputEvents(opt_.replayInput));
         while (!glfwWindowShouldClose(win_)) {
             const auto t0 = Clock::now();
             glfwPollEvents();
             syncViewport();
             pollJob();
             if (!job_) {
-                if (ctl_.readyForEvents())
-                    for (; next < events.size() && events[next].frame == eventFrame; ++next)
-                        dispatch(events[next]);
+                replay.deliver(ctl_, [this](const InputEvent& e) { dispatch(e); });
                 ctl_.step();
                 takeFinished();
             }
             const auto drawStart = Clock::now();
             draw();
-            if (batch_ && !job_ && !ctl_.busy() && ctl_.drag() == DragKind::None &&
-                eventFrame >= lastFrame) {
+            if (batch_ && !job_ && !ctl_.busy() && ctl_.drag() == DragKind::None && replay.over()) {
                 if (!opt_.screenshot.empty()) screenshot(opt_.screenshot);
                 glfwSetWindowShouldClose(win_, GLFW_TRUE);
             }
-            if (!job_ && ctl_.readyForEvents()) ++eventFrame;
+            if (!job_) replay.endFrame(ctl_);
             glfwSwapBuffers(win_);
             if (measuring_) {
                 // Latency of the segment: from its drag event to the new mesh on screen.

@@ -363,17 +363,27 @@ void SculptController::step() {
     if (releasing_) finishDrag();
 }
 
+ReplayClock::ReplayClock(std::vector<InputEvent> events)
+    : events_(std::move(events)), lastFrame_(events_.empty() ? 1 : events_.back().frame + 2) {}
+
+void ReplayClock::deliver(const SculptController& controller,
+                          const std::function<void(const InputEvent&)>& dispatch) {
+    if (!controller.readyForEvents()) return;
+    for (; next_ < events_.size() && events_[next_].frame == frame_; ++next_)
+        dispatch(events_[next_]);
+}
+
+void ReplayClock::endFrame(const SculptController& controller) {
+    if (controller.readyForEvents()) ++frame_;
+}
+
 void replayEvents(SculptController& controller, const std::vector<InputEvent>& events) {
-    const int lastFrame = events.empty() ? 1 : events.back().frame + 2;
-    std::size_t next = 0;
-    int frame = 0;
-    while (frame < lastFrame || controller.busy() || controller.drag() != DragKind::None) {
-        if (controller.readyForEvents())
-            for (; next < events.size() && events[next].frame == frame; ++next)
-                controller.dispatch(events[next]);
+    ReplayClock clock(events);
+    while (!clock.over() || controller.busy() || controller.drag() != DragKind::None) {
+        clock.deliver(controller, [&](const InputEvent& e) { controller.dispatch(e); });
         controller.step();
-        if (controller.readyForEvents()) ++frame;
-        if (frame > lastFrame + 1000) break; // a drag never released: stop waiting for it
+        clock.endFrame(controller);
+        if (clock.overtime() > 1000) break; // a drag never released: stop waiting for it
     }
     controller.wait();
     controller.step();

@@ -128,6 +128,28 @@ class SculptController {
     double volume_ = 0.0;
 };
 
+// Hands recorded events over frame by frame, as the modeler's loop and replayEvents both do:
+// a frame's events go out only when the controller takes events (see waitEachPiece), and
+// the frame count moves on only then, so a replay waits for each piece of sculpting.
+class ReplayClock {
+  public:
+    explicit ReplayClock(std::vector<InputEvent> events);
+    // Before the frame's step: its events, one by one, to `dispatch`.
+    void deliver(const SculptController& controller,
+                 const std::function<void(const InputEvent&)>& dispatch);
+    // After the frame's step.
+    void endFrame(const SculptController& controller);
+    // Every event delivered, and a frame more.
+    bool over() const { return frame_ >= lastFrame_; }
+    // Frames past the end (a drag never released keeps a replay going).
+    int overtime() const { return frame_ - lastFrame_; }
+
+  private:
+    std::vector<InputEvent> events_;
+    std::size_t next_ = 0;
+    int frame_ = 0, lastFrame_ = 1;
+};
+
 // Replays events through a controller without a window, frame by frame as the modeler
 // does (events of a frame, then one step; drops are skipped), until every piece is done.
 void replayEvents(SculptController& controller, const std::vector<InputEvent>& events);

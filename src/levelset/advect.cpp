@@ -4,9 +4,7 @@
 #include "levelset/local_tree.h"
 #include "levelset/monotone_cubic.h"
 
-#include <chrono>
 #include <cmath>
-#include <mutex>
 #include <utility>
 #include <vector>
 
@@ -14,8 +12,6 @@
 #include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/Morphology.h>
-#include <openvdb/tools/SignedFloodFill.h>
-#include <openvdb/tree/LeafManager.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
@@ -78,6 +74,13 @@ class SampleSource {
     const Grid& live_;
     GridPtr copies_;
 };
+
+// A leaf of the widened source where the old band did not reach: every voxel at the widened
+// background, with the sign the grid has there (a tile of the inside or the outside).
+void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
+    for (auto it = leaf.beginValueAll(); it; ++it)
+        it.setValue(live.getValue(it.getCoord()) < 0.0f ? -far : far);
+}
 
 // Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
 // map(x), and marks in `changed` the voxels whose value changed (where the deformation is
@@ -226,17 +229,11 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         openvdb::tools::dilateActiveValues(widen->tree(), int(std::ceil(needed - halfWidth)),
                                            openvdb::tools::NN_FACE, openvdb::tools::IGNORE_TILES);
         source->tree().topologyUnion(widen->tree());
-        // Leaves the dilation added hold the copies' background: give each voxel the sign
-        // the live grid has there (a tile of the band's inside or outside).
-        {
-            auto live = grid.getConstAccessor();
-            const float far = float(needed * h);
-            for (LeafNode* leaf : leavesIn(source->tree(), box)) {
-                if (grid.tree().probeConstLeaf(leaf->origin())) continue; // a copy
-                for (auto it = leaf->beginValueAll(); it; ++it)
-                    it.setValue(live.getValue(it.getCoord()) < 0.0f ? -far : far);
-            }
-        }
+        // Leaves the dilation added hold the copies' background, whatever the side.
+        const auto live = grid.getConstAccessor();
+        for (LeafNode* leaf : leavesIn(source->tree(), box))
+            if (!grid.tree().probeConstLeaf(leaf->origin())) // not a copy
+                farWithSigns(*leaf, float(needed * h), live);
         renormalize(*source, indexBox(grid, seg.affectedBox(), int(needed) + 1), FmmOrder::First,
                     options.interrupter);
         widened = source;
@@ -254,14 +251,12 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     stats.leavesVisited += sampled.size();
     if (widened) {
         // Leaves the band just grew into, outside the widened copies: sampling writes them,
-        // so it must not read them from the live grid; as copies they hold the sign of the
-        // tile they came from, at the widened background.
-        const float far = widened->background();
+        // so it must not read them from the live grid, which still holds their tiles' signs.
+        const auto live = grid.getConstAccessor();
         for (const LeafNode* leaf : sampled) {
             if (widened->tree().probeConstLeaf(leaf->origin())) continue;
             auto* copy = new LeafNode(*leaf);
-            for (auto it = copy->beginValueAll(); it; ++it)
-                it.setValue(*it < 0.0f ? -far : far);
+            farWithSigns(*copy, widened->background(), live);
             widened->tree().addLeaf(copy);
             ++stats.leavesCopied;
         }
