@@ -1,6 +1,7 @@
 #include "levelset/advect.h"
 #include "core/stopwatch.h"
 #include "levelset/band.h"
+#include "levelset/dilate.h"
 #include "levelset/local_tree.h"
 #include "levelset/monotone_cubic.h"
 
@@ -202,8 +203,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                 macc.setValueOn(c);
     }
     const int dilation = int(std::ceil(halfWidth)) + 1;
-    openvdb::tools::dilateActiveValues(mask->tree(), dilation, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
+    dilateByCube(mask->tree(), dilation);
     double maxStretch = 1.0;
     for (double s : stretch)
         maxStretch = std::max(maxStretch, s);
@@ -293,9 +293,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         // Only where values changed, and as far as the band reaches from there (the nearest
         // surface of a voxel nearby may have moved): where the deformation is the identity
         // (outside the tools' coatings, which fill only part of the box) the distances hold.
-        openvdb::tools::dilateActiveValues(changed->tree(), int(std::ceil(halfWidth)) + 1,
-                                           openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                           openvdb::tools::IGNORE_TILES);
+        dilateByCube(changed->tree(), int(std::ceil(halfWidth)) + 1);
         changed->tree().topologyUnion(fresh->tree());
         const FmmStats fmm =
             renormalize(grid, touched, *changed, options.renormalization, options.interrupter);

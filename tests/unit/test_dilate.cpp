@@ -1,0 +1,53 @@
+#include <random>
+
+#include <gtest/gtest.h>
+#include <openvdb/tools/Morphology.h>
+
+#include "levelset/dilate.h"
+
+using namespace sweepers;
+
+namespace {
+
+// Scattered voxels and a few solid blocks, across leaf and internal-node boundaries and on
+// both sides of the origin.
+openvdb::MaskTree::Ptr randomMask(unsigned seed) {
+    std::mt19937 gen(seed);
+    std::uniform_int_distribution<int> coord(-70, 70), size(1, 12);
+    auto tree = std::make_shared<openvdb::MaskTree>();
+    for (int i = 0; i < 300; ++i)
+        tree->setValueOn(openvdb::Coord(coord(gen), coord(gen), coord(gen)));
+    for (int i = 0; i < 5; ++i) {
+        const openvdb::Coord lo(coord(gen), coord(gen), coord(gen));
+        for (int x = 0, s = size(gen); x < s; ++x)
+            for (int y = 0; y < s; ++y)
+                for (int z = 0; z < s; ++z)
+                    tree->setValueOn(lo.offsetBy(x, y, z));
+    }
+    return tree;
+}
+
+} // namespace
+
+TEST(DilateByCube, EqualsRepeatedTwentySixNeighbourDilation) {
+    for (unsigned seed = 1; seed <= 3; ++seed)
+        for (int radius : {0, 1, 2, 3, 4, 5, 7, 8, 9, 13}) {
+            const auto mask = randomMask(seed);
+            auto expected = std::make_shared<openvdb::MaskTree>(*mask);
+            if (radius > 0)
+                openvdb::tools::dilateActiveValues(*expected, radius,
+                                                   openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                                   openvdb::tools::IGNORE_TILES);
+            dilateByCube(*mask, radius);
+            EXPECT_EQ(mask->activeVoxelCount(), expected->activeVoxelCount())
+                << "seed " << seed << " radius " << radius;
+            EXPECT_TRUE(mask->hasSameTopology(*expected))
+                << "seed " << seed << " radius " << radius;
+        }
+}
+
+TEST(DilateByCube, RefusesANegativeRadius) {
+    openvdb::MaskTree tree;
+    tree.setValueOn(openvdb::Coord(0));
+    EXPECT_THROW(dilateByCube(tree, -1), std::invalid_argument);
+}
