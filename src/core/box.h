@@ -29,6 +29,10 @@ struct Box {
     bool contains(const Eigen::Vector3d& p) const {
         return (p.array() >= min.array()).all() && (p.array() <= max.array()).all();
     }
+    bool overlaps(const Box& b) const {
+        return !empty() && !b.empty() && (min.array() <= b.max.array()).all() &&
+               (b.min.array() <= max.array()).all();
+    }
     Eigen::Vector3d extent() const {
         return empty() ? Eigen::Vector3d(Eigen::Vector3d::Zero()) : Eigen::Vector3d(max - min);
     }

@@ -26,6 +26,11 @@ class StepDeformation {
     // Outside this box every sub-step, and so the whole deformation, is the identity.
     const Box& affectedBox() const { return affected_; }
 
+    // True when every sub-step is the identity on all of `box` (false when unsure): there,
+    // sampling the inverse would give back each voxel's own value. By default, when the
+    // box misses the affected box.
+    virtual bool identityOn(const Box& box) const { return !affected_.overlaps(box); }
+
     // Inverse of sub-step k.
     virtual Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const;
     // Whole inverse: inverse sub-steps s-1 down to 0.

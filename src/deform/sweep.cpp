@@ -121,6 +121,24 @@ SweepSegment::SweepSegment(const Sweep& sweep, std::size_t index, const SegmentO
     }
 }
 
+bool SweepSegment::identityOn(const Box& box) const {
+    if (box.empty()) return true;
+    const Eigen::Vector3d centre = 0.5 * (box.min + box.max);
+    const double radius = 0.5 * box.extent().norm();
+    for (int k = 0; k < steps_; ++k) {
+        if (!stepBoxes_[k].overlaps(box)) continue;
+        for (const ToolPlan& t : tools_) {
+            const PlacedTool& tool = *t.placed[k + 1];
+            // A distance is 1-Lipschitz, so no point of the box is nearer the tool than
+            // distance(centre) - radius; the influence is 0 from the falloff width on (3.3).
+            // The margin covers the rounding of shapes whose distance is solved for.
+            if (tool.distance(centre) - radius < tool.falloff() * (1.0 + 1e-9) + 1e-12)
+                return false;
+        }
+    }
+    return true;
+}
+
 std::optional<MotionLog> SweepSegment::stepLog(int k, const Eigen::Vector3d& p) const {
     if (!stepBoxes_[k].contains(p)) return std::nullopt;
     // Normalized blend 3.17 / 5.19: c = (1 - prod(1 - phi_j)) / sum(phi_j).

@@ -63,6 +63,9 @@ class SweepSegment : public StepDeformation {
     // Tool j at sub-step placement tau_k, k in [0, s].
     const PlacedTool& placedTool(std::size_t j, int k) const { return *tools_[j].placed[k]; }
 
+    // Also true where the box lies in the affected box but beyond every tool's coating.
+    bool identityOn(const Box& box) const override;
+
   protected:
     // The normalized blend of sub-step k at p (tools at tau_{k+1}).
     std::optional<MotionLog> stepLog(int k, const Eigen::Vector3d& p) const override;

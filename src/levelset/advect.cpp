@@ -64,6 +64,34 @@ class SampleSource {
             return live_.probeValue(ijk, v);
         }
 
+        // Trilinear interpolation at index-space point p (OpenVDB's BoxSampler, to the bit).
+        // When the cell lies inside one leaf (343 cells in 512) its eight corners are read
+        // from that leaf's buffer, after a single lookup instead of eight.
+        float trilinear(const openvdb::Vec3d& p) const {
+            const openvdb::Vec3i base = openvdb::tools::local_util::floorVec3(p);
+            const openvdb::Vec3d uvw = p - base;
+            const openvdb::Coord ijk(base);
+            float data[2][2][2];
+            const LeafNode* leaf = nullptr;
+            if ((ijk[0] & 7) < 7 && (ijk[1] & 7) < 7 && (ijk[2] & 7) < 7) {
+                leaf = copy(ijk);
+                if (!leaf) leaf = live_.probeConstLeaf(ijk);
+            }
+            if (leaf) {
+                const openvdb::Index o = LeafNode::coordToOffset(ijk);
+                for (int i = 0; i < 2; ++i)
+                    for (int j = 0; j < 2; ++j)
+                        for (int k = 0; k < 2; ++k)
+                            data[i][j][k] = leaf->getValue(o + i * 64 + j * 8 + k);
+            } else {
+                for (int i = 0; i < 2; ++i)
+                    for (int j = 0; j < 2; ++j)
+                        for (int k = 0; k < 2; ++k)
+                            data[i][j][k] = getValue(ijk.offsetBy(i, j, k));
+            }
+            return openvdb::tools::BoxSampler::trilinearInterpolation(data, uvw);
+        }
+
       private:
         const LeafNode* copy(const openvdb::Coord& ijk) const {
             return copies_.probeConstLeaf(ijk);
@@ -105,7 +133,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                     xform.worldToIndex(toVdb(map(toEigen(xform.indexToWorld(ijk)))));
                 float v = 0.0f;
                 if (sampling == Sampling::Trilinear)
-                    openvdb::tools::BoxSampler::sample(acc, p, v);
+                    v = acc.trilinear(p);
                 else
                     v = float(sampleMonotoneCubic(acc, p));
                 if (v != *it || !acc.isValueOn(ijk)) marks.local().push_back(ijk);
@@ -153,16 +181,29 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     //    every image; also measure how far apart the images of neighbouring voxels land
     //    (the stretch), which bounds how far a pre-image can sit from the old surface.
     auto t0 = Clock::now();
+    // Leaves where the deformation is the identity (within a voxel of them: the stretch
+    // reads half a voxel around an image) keep their values; their interface voxels are
+    // their own images.
+    const auto still = [&](const LeafNode& leaf) {
+        openvdb::CoordBBox box = leaf.getNodeBoundingBox();
+        box.expand(1);
+        const openvdb::BBoxd world = grid.transform().indexToWorld(box);
+        return seg.identityOn(Box(toEigen(world.min()), toEigen(world.max())));
+    };
     std::vector<openvdb::Coord> interface;
+    std::vector<bool> interfaceStill;
     {
         auto acc = grid.getConstAccessor();
         const auto leaves = leavesIn(std::as_const(grid.tree()), region);
         stats.leavesVisited += leaves.size();
         for (const LeafNode* leaf : leaves) {
             stats.voxelsVisited += leaf->onVoxelCount();
+            const bool leafStill = still(*leaf);
             for (auto it = leaf->cbeginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
-                if (region.isInside(ijk) && nextToCrossing(acc, ijk, *it)) interface.push_back(ijk);
+                if (!region.isInside(ijk) || !nextToCrossing(acc, ijk, *it)) continue;
+                interface.push_back(ijk);
+                interfaceStill.push_back(leafStill);
             }
         }
     }
@@ -175,6 +216,10 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         Marks& m = marks.local();
         double& worst = stretch.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            if (interfaceStill[i]) {
+                m.push_back(interface[i]);
+                continue;
+            }
             Eigen::Vector3d p = toEigen(grid.indexToWorld(interface[i]));
             for (int k = 0; k < seg.steps(); ++k) {
                 p = seg.forwardStep(k, p, forwardTolerance).p;
@@ -261,21 +306,27 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             ++stats.leavesCopied;
         }
     }
+    // Only leaves the deformation moves are resampled (and copied before they are written):
+    // elsewhere a sample at a voxel centre gives back its own value. A widened band is the
+    // exception: its values differ from the grid's, so every leaf is resampled from it.
+    std::vector<LeafNode*> moving;
+    for (LeafNode* leaf : sampled)
+        if (widened || !still(*leaf)) moving.push_back(leaf);
     auto source = [&](int k) {
         if (widened && k == 0) return std::make_shared<SampleSource>(grid, widened);
-        auto copy = SampleSource::copyOnWrite(grid, sampled);
-        stats.leavesCopied += sampled.size();
+        auto copy = SampleSource::copyOnWrite(grid, moving);
+        stats.leavesCopied += moving.size();
         return copy;
     };
     if (!options.resampleEachSubStep) {
         stats.sampledVoxels = resample(
-            grid, sampled, *source(0), region,
+            grid, moving, *source(0), region,
             [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); }, options.sampling, *changed,
             options.interrupter);
     } else {
         for (int k = 0; k < seg.steps(); ++k)
             stats.sampledVoxels += resample(
-                grid, sampled, *source(k), region,
+                grid, moving, *source(k), region,
                 [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling,
                 *changed, options.interrupter);
     }

@@ -265,3 +265,32 @@ TEST(Sweep, RefusesMalformedSweeps) {
     const Sweep huge{{ball(0.3, 0.01, {at({0, 0, 0}), at({100, 0, 0})})}};
     EXPECT_THROW(SweepSegment(huge, 0), std::domain_error);
 }
+
+TEST(Sweep, IdentityOnlyWhereNoToolReaches) {
+    // Boxes the segment claims it leaves alone must hold only fixed points; of the boxes
+    // inside the affected box, some (beyond the coatings) must be claimed, or the test
+    // would not tell the sweep's answer from the affected-box default.
+    Rng rng(7);
+    for (const Case& c : cases()) {
+        const SweepSegment seg(c.sweep, 0);
+        const Box& affected = seg.affectedBox();
+        int claimed = 0, claimedInside = 0;
+        for (int trial = 0; trial < 400; ++trial) {
+            const Eigen::Vector3d centre =
+                rng.inBox(affected.min.array() - 0.2, affected.max.array() + 0.2);
+            const Box box(centre.array() - 0.05, centre.array() + 0.05);
+            if (!seg.identityOn(box)) continue;
+            ++claimed;
+            claimedInside += affected.overlaps(box);
+            for (int i = 0; i < 20; ++i) {
+                const Eigen::Vector3d p = rng.inBox(box.min, box.max);
+                ASSERT_EQ(seg.inverseMap(p), p) << c.name << " at " << p.transpose();
+            }
+        }
+        EXPECT_GT(claimed, 0) << c.name;
+        EXPECT_GT(claimedInside, 0) << c.name;
+        // A box around the tool is never left alone.
+        const Eigen::Vector3d t = c.sweep.tools[0].path[0].t;
+        EXPECT_FALSE(seg.identityOn(Box(t.array() - 0.01, t.array() + 0.01))) << c.name;
+    }
+}
