@@ -22,8 +22,9 @@ inline openvdb::Coord cubeCorner(const openvdb::Coord& base, int c) {
 
 // grad phi at a voxel by central differences, in world units (voxel size h): the surface
 // normal of 5.17 and the unit-gradient check of a signed distance.
-inline Eigen::Vector3f centralGradient(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk,
-                                       double h) {
+// `acc` is anything with getValue(Coord): a tree accessor, or a block of copied values.
+template <typename Accessor>
+Eigen::Vector3f centralGradient(const Accessor& acc, const openvdb::Coord& ijk, double h) {
     Eigen::Vector3f g;
     for (int a = 0; a < 3; ++a) {
         openvdb::Coord lo = ijk, hi = ijk;

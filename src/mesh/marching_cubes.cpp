@@ -1,5 +1,6 @@
 #include "mesh/marching_cubes.h"
 
+#include <array>
 #include <unordered_map>
 #include <utility>
 
@@ -20,11 +21,41 @@ std::uint64_t makeKey(const openvdb::Coord& c, int axis) {
            std::uint64_t(c.z() + off) | (std::uint64_t(axis) << 60);
 }
 
+// The values meshing one leaf reads, copied once so that every read is an array lookup:
+// the leaf and the voxels from one before it to two past it along each axis (cube corners
+// reach one voxel past the leaf, and central differences at those corners one more on
+// either side).
+class LeafBlock {
+  public:
+    static constexpr int kDim = int(LeafNode::DIM), kSpan = kDim + 3;
+
+    LeafBlock(const Grid::ConstAccessor& acc, const LeafNode& leaf) : origin_(leaf.origin()) {
+        for (int x = 0; x < kSpan; ++x)
+            for (int y = 0; y < kSpan; ++y)
+                for (int z = 0; z < kSpan; ++z) {
+                    const int lx = x - 1, ly = y - 1, lz = z - 1; // leaf-local coordinates
+                    const bool inside =
+                        lx >= 0 && lx < kDim && ly >= 0 && ly < kDim && lz >= 0 && lz < kDim;
+                    values_[(x * kSpan + y) * kSpan + z] =
+                        inside ? leaf.getValue(openvdb::Index((lx * kDim + ly) * kDim + lz))
+                               : acc.getValue(origin_.offsetBy(lx, ly, lz));
+                }
+    }
+    float getValue(const openvdb::Coord& c) const {
+        const openvdb::Coord l = c - origin_;
+        return values_[((l.x() + 1) * kSpan + l.y() + 1) * kSpan + l.z() + 1];
+    }
+
+  private:
+    openvdb::Coord origin_;
+    std::array<float, kSpan * kSpan * kSpan> values_;
+};
+
 MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
     MeshChunk chunk;
     const Grid::TreeType::LeafNodeType* leaf = grid.tree().probeConstLeaf(origin);
     if (!leaf) return chunk;
-    Grid::ConstAccessor acc = grid.getConstAccessor();
+    const LeafBlock acc(grid.getConstAccessor(), *leaf);
     const auto& xform = grid.transform();
     const double h = grid.voxelSize()[0];
     std::unordered_map<std::uint64_t, int> vertexOf;
