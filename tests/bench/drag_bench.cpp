@@ -1,7 +1,8 @@
 // The interactive budget: data/drag.json, a recorded drag of 100 short segments with a
 // ball tool of radius 0.25 on the unit sphere, replayed as the modeler does it (advect,
-// renormalize, re-mesh the touched leaves after every segment). Reports the latency of a
-// segment, p50 and p95, split by stage, and the process's peak memory.
+// renormalize, re-mesh the touched leaves after every segment), at every size of the run
+// and one twice as fine as the finest. Reports the latency of a segment, p50 and p95,
+// split by stage, and the process's peak memory.
 //
 // The scale group: the first 20 segments of the same drag at voxel size 1/128 on spheres
 // of radius 1, 2 and 4 (the drag moved out to the surface): a segment must cost what the
@@ -85,7 +86,11 @@ void registerScaleBenchmarks() {
 }
 
 void registerDragBenchmarks() {
-    for (const int div : voxelDivisions()) {
+    // Every size of the run, and one twice as fine as the finest (1/512 by default): where
+    // the interactive budget stands on a grid finer than the modeler's default.
+    std::vector<int> divisions = voxelDivisions();
+    divisions.push_back(2 * *std::max_element(divisions.begin(), divisions.end()));
+    for (const int div : divisions) {
         add(
             "drag/drag100_h" + std::to_string(div) + "/sweepers",
             [div](benchmark::State& state) {
