@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -143,11 +144,15 @@ int runInfo(const std::string& path, bool asJson) {
     return 0;
 }
 
+void reportMeshWritten(const std::string& path, const TriangleMesh& mesh) {
+    std::fprintf(stderr, "wrote %s: %zu vertices, %zu triangles\n", path.c_str(),
+                 mesh.positions.size(), mesh.triangles.size());
+}
+
 void exportMesh(const Grid& grid, const std::string& path) {
     const TriangleMesh mesh = meshLevelSet(grid);
     writeMesh(mesh, path);
-    std::fprintf(stderr, "wrote %s: %zu vertices, %zu triangles\n", path.c_str(),
-                 mesh.positions.size(), mesh.triangles.size());
+    reportMeshWritten(path, mesh);
 }
 
 struct ApplyArgs {
@@ -202,7 +207,17 @@ int runApply(const ApplyArgs& a) {
         ren += r.stats.renormalizeSeconds;
         grow += r.stats.growSeconds;
     }
-    writeLevelSet(grid, a.output);
+    // Both files are written before either replaces its old version: a failed mesh write
+    // leaves no new grid behind.
+    AtomicWrite vdb = prepareLevelSet(grid, a.output);
+    std::optional<AtomicWrite> meshFile;
+    TriangleMesh mesh;
+    if (!a.mesh.empty()) {
+        mesh = meshLevelSet(grid);
+        meshFile.emplace(prepareMesh(mesh, a.mesh));
+    }
+    vdb.commit();
+    if (meshFile) meshFile->commit();
     const double after = measureLevelSet(grid).volume;
     if (!a.quiet)
         std::fprintf(stderr,
@@ -210,7 +225,7 @@ int runApply(const ApplyArgs& a) {
                      "renormalization %.3f s), volume %.6g -> %.6g (%+.3f%%)\n",
                      a.output.c_str(), reports.size(), grow, adv, ren, before, after,
                      100.0 * (after - before) / before);
-    if (!a.mesh.empty()) exportMesh(grid, a.mesh);
+    if (meshFile) reportMeshWritten(a.mesh, mesh);
     return 0;
 }
 

@@ -41,7 +41,7 @@ void requireMeshPath(const std::string& path) {
     if (!isMeshPath(path)) throw FileError(path + ": unknown mesh format (use .obj, .ply or .stl)");
 }
 
-void writeMesh(const TriangleMesh& mesh, const std::string& path) {
+AtomicWrite prepareMesh(const TriangleMesh& mesh, const std::string& path) {
     requireMeshPath(path);
     const char* format = exportFormat(extension(path));
 
@@ -76,11 +76,19 @@ void writeMesh(const TriangleMesh& mesh, const std::string& path) {
             new unsigned int[3]{unsigned(mesh.triangles[f][0]), unsigned(mesh.triangles[f][1]),
                                 unsigned(mesh.triangles[f][2])};
     }
-    writeFileAtomically(path, [&](const std::string& tmp) {
-        Assimp::Exporter exporter;
-        if (exporter.Export(scene.get(), format, tmp) != AI_SUCCESS)
-            throw FileError(path + ": cannot write the mesh (" + exporter.GetErrorString() + ")");
+    // Exported into memory, then written with checked writes (Assimp's own file output does
+    // not report a full disk).
+    Assimp::Exporter exporter;
+    const aiExportDataBlob* blob = exporter.ExportToBlob(scene.get(), format);
+    if (!blob)
+        throw FileError(path + ": cannot write the mesh (" + exporter.GetErrorString() + ")");
+    return AtomicWrite(path, [&](std::ostream& out) {
+        out.write(static_cast<const char*>(blob->data), std::streamsize(blob->size));
     });
+}
+
+void writeMesh(const TriangleMesh& mesh, const std::string& path) {
+    prepareMesh(mesh, path).commit();
 }
 
 TriangleMesh readMesh(const std::string& path) {

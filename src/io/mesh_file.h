@@ -11,6 +11,8 @@ namespace sweepers {
 
 // Throws FileError for an unknown extension or a failed write; the write is atomic.
 void writeMesh(const TriangleMesh& mesh, const std::string& path);
+// The same, written and flushed but not yet in place: commit() puts it there.
+AtomicWrite prepareMesh(const TriangleMesh& mesh, const std::string& path);
 // Throws FileError when the file cannot be read or holds no triangles.
 TriangleMesh readMesh(const std::string& path);
 

@@ -45,17 +45,32 @@ GridPtr readLevelSet(const std::string& path) {
         (seen.empty() ? std::string(" (it holds no grids)") : " (it holds " + seen + ")"));
 }
 
-void writeLevelSet(const Grid& grid, const std::string& path) {
+namespace {
+
+// io::File writes through a stream of its own and does not report a failed write; this
+// writes the same file format (seekable, with grid offsets, as io::File::write does) into
+// the caller's stream, whose writes are checked.
+class FileWriter : public openvdb::io::Archive {
+  public:
+    openvdb::io::Archive::Ptr copy() const override { return std::make_shared<FileWriter>(*this); }
+    void write(std::ostream& out, const openvdb::GridCPtrVec& grids) const {
+        Archive::write(out, grids, /*seekable=*/true);
+    }
+};
+
+} // namespace
+
+AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path) {
     initVdb();
     GridPtr copy = grid.deepCopy();
     markAsDocument(*copy);
     copy->insertMeta("voxel_size", openvdb::FloatMetadata(float(grid.voxelSize()[0])));
-    writeFileAtomically(path, [&](const std::string& tmp) {
-        openvdb::io::File file(tmp);
-        openvdb::GridPtrVec grids{copy};
-        file.write(grids);
-        file.close();
-    });
+    return AtomicWrite(
+        path, [&](std::ostream& out) { FileWriter().write(out, openvdb::GridCPtrVec{copy}); });
+}
+
+void writeLevelSet(const Grid& grid, const std::string& path) {
+    prepareLevelSet(grid, path).commit();
 }
 
 } // namespace sweepers

@@ -8,6 +8,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "io/atomic_file.h"
 #include "levelset/vdb.h"
 
 namespace sweepers {
@@ -18,7 +19,9 @@ class FileError : public std::runtime_error {
 };
 
 GridPtr readLevelSet(const std::string& path);
-// Atomic: temporary file, flush, rename.
+// Atomic (io/atomic_file.h): a failed write, a full disk included, keeps the old file.
 void writeLevelSet(const Grid& grid, const std::string& path);
+// The same, written and flushed but not yet in place: commit() puts it there.
+AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path);
 
 } // namespace sweepers
