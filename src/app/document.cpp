@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/format.h"
 #include "io/atomic_file.h"
 #include "io/mesh_file.h"
 #include "io/start_grid.h"
@@ -20,7 +21,7 @@ Document::Document(StrokeScript script, const std::string& scriptDir, const Prog
     if (script_.start.kind == StartShape::Kind::Vdb &&
         std::abs(h - script_.grid.voxelSize) > 1e-9 * script_.grid.voxelSize)
         throw std::runtime_error(
-            "the document starts from a VDB file at voxel size " + std::to_string(h) +
+            "the document starts from a VDB file at voxel size " + formatNumber(h) +
             "; it cannot be replayed at another voxel size (start from a sphere or a mesh)");
     sculptor_.setInterrupter(interrupter);
     applyStrokes(sculptor_, script_.strokes, progress);

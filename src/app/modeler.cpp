@@ -26,6 +26,7 @@
 #include "app/gl_renderer.h"
 #include "app/input_replay.h"
 #include "app/sculpt_controller.h"
+#include "core/format.h"
 #include "core/statistics.h"
 #include "core/stopwatch.h"
 #include "io/atomic_file.h"
@@ -399,7 +400,7 @@ class Modeler {
                 fail("the voxel size must lie between 0.0001 and 0.5");
             } else {
                 const bool modified = doc_->modified();
-                startJob("resampling to voxel size " + std::to_string(h),
+                startJob("resampling to voxel size " + formatNumber(h),
                          [script, dir, h, modified](const Progress& p, Interrupter* stop) {
                              auto d = std::make_unique<Document>(
                                  Document::replayAt(script, dir, h, p, stop));

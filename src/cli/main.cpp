@@ -13,6 +13,7 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include "core/format.h"
 #include "io/atomic_file.h"
 #include "io/mesh_file.h"
 #include "io/start_grid.h"
@@ -49,6 +50,7 @@ void requireWritable(const std::string& path) {
 
 int runCheck(const std::string& path, bool asJson) {
     const StrokeScript script = readStrokeScript(path);
+    requireBuildableStart(script); // the limits apply holds the script to
     json out = json::array();
     for (std::size_t i = 0; i < script.strokes.size(); ++i) {
         if (const auto* sweep = std::get_if<SweepStroke>(&script.strokes[i])) {
@@ -131,14 +133,18 @@ int runInfo(const std::string& path, bool asJson) {
         std::cout << j.dump(2) << "\n";
         return 0;
     }
+    char bbox[160] = "empty (no active voxels)";
+    if (m.activeVoxels > 0)
+        std::snprintf(bbox, sizeof bbox, "[%g %g %g] - [%g %g %g]", m.bounds.min.x(),
+                      m.bounds.min.y(), m.bounds.min.z(), m.bounds.max.x(), m.bounds.max.y(),
+                      m.bounds.max.z());
     std::printf("%s\n  voxel size %g, half-width %g voxels\n  %zu active voxels in %zu leaves, "
-                "%.1f MiB\n  bbox [%g %g %g] - [%g %g %g]\n  volume %.6g, area %.6g\n"
+                "%.1f MiB\n  bbox %s\n  volume %.6g, area %.6g\n"
                 "  Euler characteristic %d (LevelSetMeasure's curvature integral: %d), genus %d, "
                 "%zu connected component(s)\n",
                 path.c_str(), m.voxelSize, m.halfWidth, m.activeVoxels, m.leafNodes,
-                m.memoryBytes / 1048576.0, m.bounds.min.x(), m.bounds.min.y(), m.bounds.min.z(),
-                m.bounds.max.x(), m.bounds.max.y(), m.bounds.max.z(), m.volume, m.area,
-                m.eulerCharacteristic, m.curvatureEuler, m.genus, m.components);
+                m.memoryBytes / 1048576.0, bbox, m.volume, m.area, m.eulerCharacteristic,
+                m.curvatureEuler, m.genus, m.components);
     std::printf("  marching-cubes surface: %zu triangles, enclosed volume %.6g\n",
                 mesh.triangles.size(), meshVolume);
     return 0;
@@ -158,7 +164,8 @@ void exportMesh(const Grid& grid, const std::string& path) {
 struct ApplyArgs {
     std::string script, output, mesh;
     double voxelSize = 0.0;
-    bool perSubStep = false, quiet = false, firstOrder = false, stats = false, cubic = false;
+    bool perSubStep = false, quiet = false, firstOrder = false, stats = false, cubic = false,
+         force = false;
 };
 
 int runApply(const ApplyArgs& a) {
@@ -174,7 +181,8 @@ int runApply(const ApplyArgs& a) {
     options.renormalization = a.firstOrder ? FmmOrder::First : FmmOrder::Second;
     options.sampling = a.cubic ? Sampling::MonotoneCubic : Sampling::Trilinear;
     options.interrupter = &gStop;
-    Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop), options);
+    Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop, a.force),
+                      options);
     const Grid& grid = sculptor.grid();
     const double before = measureLevelSet(grid).volume;
     if (a.stats) sculptor.startMeshing();
@@ -254,6 +262,9 @@ static int run(int argc, char** argv) {
     create->add_option("--voxel-size", voxelSize, "Voxel size")->check(CLI::PositiveNumber);
     create->add_option("--half-width", halfWidth, "Band half-width in voxels")
         ->check(CLI::Range(2.0, 64.0));
+    bool force = false;
+    create->add_flag("--force", force,
+                     "Build the sphere even when it seems to need more memory than is free");
 
     ApplyArgs applyArgs;
     CLI::App* apply = app.add_subcommand("apply", "Apply a stroke script and write the result");
@@ -267,6 +278,8 @@ static int run(int argc, char** argv) {
     apply->add_flag("--monotone-cubic", applyArgs.cubic,
                     "Resample with the monotone cubic of appendix C.1 instead of trilinear");
     apply->add_flag("-q,--quiet", applyArgs.quiet, "No progress output");
+    apply->add_flag("--force", applyArgs.force,
+                    "Build the start shape even when it seems to need more memory than is free");
     apply->add_flag("--stats", applyArgs.stats,
                     "Print a table of per-segment timings (band growth, sampling, "
                     "renormalization, incremental re-meshing)");
@@ -298,10 +311,11 @@ static int run(int argc, char** argv) {
         if (*apply) return runApply(applyArgs);
         if (*create) {
             if (!(radius / voxelSize >= 1.5 && radius / voxelSize <= 1e5))
-                throw std::runtime_error("the sphere would be " +
-                                         std::to_string(radius / voxelSize) +
+                throw std::runtime_error("the sphere would be " + formatNumber(radius / voxelSize) +
                                          " voxels in radius; use 1.5 to 100000");
             requireWritable(output);
+            requireMemoryForBand(4.0 * M_PI * radius * radius, voxelSize, halfWidth,
+                                 kSphereBytesPerVoxel, force);
             const GridPtr g =
                 makeSphere({center[0], center[1], center[2]}, radius, voxelSize, halfWidth);
             writeLevelSet(*g, output);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <fstream>
 #include <memory>
 
@@ -43,6 +44,9 @@ void requireMeshPath(const std::string& path) {
 
 AtomicWrite prepareMesh(const TriangleMesh& mesh, const std::string& path) {
     requireMeshPath(path);
+    if (mesh.triangles.empty())
+        throw FileError(path + ": nothing to write: the surface is empty (the level set has no "
+                               "zero crossing)");
     const char* format = exportFormat(extension(path));
 
     // A one-mesh scene; the aiScene destructor frees everything it points to.
@@ -91,16 +95,52 @@ void writeMesh(const TriangleMesh& mesh, const std::string& path) {
     prepareMesh(mesh, path).commit();
 }
 
+namespace {
+
+// What Assimp's post-processing would crash on (it trusts face indices): checked on the
+// scene as read.
+void validateScene(const aiScene& scene, const std::string& path) {
+    std::size_t nonFinite = 0;
+    for (unsigned mi = 0; mi < scene.mNumMeshes; ++mi) {
+        const aiMesh* m = scene.mMeshes[mi];
+        for (unsigned i = 0; i < m->mNumVertices; ++i) {
+            const aiVector3D& v = m->mVertices[i];
+            if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) ++nonFinite;
+        }
+        for (unsigned f = 0; f < m->mNumFaces; ++f)
+            for (unsigned k = 0; k < m->mFaces[f].mNumIndices; ++k)
+                if (m->mFaces[f].mIndices[k] >= m->mNumVertices)
+                    throw FileError(path + ": face " + std::to_string(f) + " refers to vertex " +
+                                    std::to_string(int(m->mFaces[f].mIndices[k])) +
+                                    ", but the mesh has " + std::to_string(m->mNumVertices) +
+                                    " vertices");
+    }
+    if (nonFinite > 0)
+        throw FileError(path + ": " + std::to_string(nonFinite) +
+                        " vertices have coordinates that are not finite numbers");
+}
+
+} // namespace
+
 TriangleMesh readMesh(const std::string& path) {
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
     Assimp::Importer importer;
-    // Normals are dropped before joining, so that formats with per-face normals (STL) weld
-    // by position and come back watertight.
-    const aiScene* scene =
-        importer.ReadFile(path, aiProcess_Triangulate | aiProcess_DropNormals |
-                                    aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
-    if (!scene)
-        throw FileError(path + ": cannot read the mesh (" + importer.GetErrorString() + ")");
+    const aiScene* scene = importer.ReadFile(path, 0);
+    if (scene) {
+        validateScene(*scene, path);
+        // Normals are dropped before joining, so that formats with per-face normals (STL)
+        // weld by position and come back watertight.
+        scene =
+            importer.ApplyPostProcessing(aiProcess_Triangulate | aiProcess_DropNormals |
+                                         aiProcess_JoinIdenticalVertices | aiProcess_SortByPType);
+    }
+    if (!scene) {
+        const std::string why = importer.GetErrorString();
+        if (why.find("bad_alloc") != std::string::npos)
+            throw FileError(path + ": the file announces more data than memory can hold (a "
+                                   "damaged header?)");
+        throw FileError(path + ": cannot read the mesh (" + why + ")");
+    }
     TriangleMesh out;
     for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
         const aiMesh* m = scene->mMeshes[mi];
@@ -114,6 +154,12 @@ TriangleMesh readMesh(const std::string& path) {
         }
     }
     if (out.triangles.empty()) throw FileError(path + ": the mesh has no triangles");
+    // A level set needs an inside: every edge must join two triangles.
+    const MeshTopology topology = meshTopology(out);
+    if (topology.boundaryEdges > 0)
+        throw FileError(path + ": the mesh is not closed (" +
+                        std::to_string(topology.boundaryEdges) +
+                        " edges border a single triangle), so it has no inside");
     return out;
 }
 

@@ -1,6 +1,10 @@
 #include "io/start_grid.h"
 
 #include <cmath>
+#include <cstdio>
+
+#include "core/format.h"
+#include "core/memory.h"
 
 #include "io/mesh_file.h"
 #include "io/stroke_script.h"
@@ -9,20 +13,44 @@
 
 namespace sweepers {
 
-GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir, double voxelSize,
-                      Interrupter* interrupter) {
+void requireMemoryForBand(double area, double voxelSize, double halfWidth, double bytesPerVoxel,
+                          bool force) {
+    // The band is 2 halfWidth voxels thick over the surface.
+    const double voxels = area / (voxelSize * voxelSize) * 2.0 * halfWidth;
+    const double needed = voxels * bytesPerVoxel;
+    const double available = availableMemoryBytes();
+    if (force || available <= 0.0 || needed <= available) return;
+    char count[32];
+    std::snprintf(count, sizeof count, "%.2g", voxels);
+    throw ScriptError("the start shape needs about " + formatBytes(needed) + " of memory (" +
+                      count + " band voxels at voxel size " + formatNumber(voxelSize) +
+                      "), more than the " + formatBytes(available) +
+                      " available; use a coarser voxel size, or --force to try anyway");
+}
+
+void requireBuildableStart(const StrokeScript& script, double voxelSize, bool force) {
     const double h = voxelSize > 0 ? voxelSize : script.grid.voxelSize;
     const double hw = script.grid.halfWidth;
     if (hw < kMinHalfWidth)
         throw ScriptError("the band half-width must be at least 2 voxels for meshing");
     const StartShape& s = script.start;
+    if (s.kind != StartShape::Kind::Sphere) return;
+    if (s.radius / h > 1e5 || s.radius / h < 1.5)
+        throw ScriptError("a sphere of radius " + formatNumber(s.radius) + " at voxel size " +
+                          formatNumber(h) + " is " + formatNumber(s.radius / h) +
+                          " voxels in radius; use 1.5 to 100000");
+    requireMemoryForBand(4.0 * M_PI * s.radius * s.radius, h, hw, kSphereBytesPerVoxel, force);
+}
+
+GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir, double voxelSize,
+                      Interrupter* interrupter, bool force) {
+    requireBuildableStart(script, voxelSize, force);
+    const double h = voxelSize > 0 ? voxelSize : script.grid.voxelSize;
+    const double hw = script.grid.halfWidth;
+    const StartShape& s = script.start;
     auto resolve = [&](const std::string& f) { return f.front() == '/' ? f : scriptDir + "/" + f; };
     switch (s.kind) {
     case StartShape::Kind::Sphere:
-        if (s.radius / h > 1e5 || s.radius / h < 1.5)
-            throw ScriptError("a sphere of radius " + std::to_string(s.radius) + " at voxel size " +
-                              std::to_string(h) + " is " + std::to_string(s.radius / h) +
-                              " voxels across; use 1.5 to 100000");
         return makeSphere(s.center, s.radius, h, hw);
     case StartShape::Kind::Vdb: {
         GridPtr g = readLevelSet(resolve(s.file));
@@ -35,6 +63,7 @@ GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir, 
     }
     case StartShape::Kind::Mesh: {
         const TriangleMesh m = readMesh(resolve(s.file));
+        requireMemoryForBand(surfaceArea(m), h, hw, kMeshBytesPerVoxel, force);
         return levelSetFromMesh(m.positions, m.triangles, h, hw, interrupter);
     }
     }

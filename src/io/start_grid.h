@@ -10,8 +10,23 @@
 namespace sweepers {
 
 // voxelSize > 0 overrides the script's grid.voxel_size. Throws ScriptError (or a file
-// error) for a start that cannot be made, Cancelled when `interrupter` stops it.
+// error) for a start that cannot be made, or whose band would need more memory than the
+// machine has available (unless `force`), Cancelled when `interrupter` stops it.
 GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir,
-                      double voxelSize = 0.0, Interrupter* interrupter = nullptr);
+                      double voxelSize = 0.0, Interrupter* interrupter = nullptr,
+                      bool force = false);
+
+// The checks makeStartGrid makes before it reads or builds anything: the half-width, and for
+// a sphere its size in voxels and the memory its band needs. `check` makes them too.
+void requireBuildableStart(const StrokeScript& script, double voxelSize = 0.0, bool force = false);
+
+// Peak memory per band voxel while a start is built (measured: a sphere about 28 bytes, a
+// mesh conversion 40 to 65), with some headroom.
+constexpr double kSphereBytesPerVoxel = 32.0, kMeshBytesPerVoxel = 64.0;
+
+// Throws ScriptError when a band of `halfWidth` voxels around a surface of `area` would
+// need more memory than is available (unless `force`), with both figures in the message.
+void requireMemoryForBand(double area, double voxelSize, double halfWidth, double bytesPerVoxel,
+                          bool force);
 
 } // namespace sweepers

@@ -2,8 +2,12 @@
 
 #include <cmath>
 #include <fstream>
+#include <functional>
 #include <initializer_list>
+#include <set>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -268,11 +272,65 @@ const char* mirrorName(MirrorAxis m) {
 
 } // namespace
 
+namespace {
+
+// A parser callback that finds the first key an object holds twice (JSON allows it; the
+// parser would keep the last silently, and a script meant something by the first too).
+// `first` is its path, "/grid/voxel_size".
+struct DuplicateKeys {
+    struct Frame {
+        bool object = false;
+        std::set<std::string> keys;
+        std::string key; // the object's current key
+        long index = -1; // the array's current element
+    };
+    std::vector<Frame> frames;
+    std::string first;
+
+    bool operator()(int /*depth*/, json::parse_event_t event, json& parsed) {
+        using E = json::parse_event_t;
+        switch (event) {
+        case E::object_start:
+        case E::array_start:
+            nextElement();
+            frames.push_back({event == E::object_start, {}, {}, -1});
+            break;
+        case E::object_end:
+        case E::array_end:
+            if (!frames.empty()) frames.pop_back();
+            break;
+        case E::key:
+            if (!frames.empty()) {
+                Frame& top = frames.back();
+                top.key = parsed.get<std::string>();
+                if (!top.keys.insert(top.key).second && first.empty()) first = path();
+            }
+            break;
+        case E::value:
+            nextElement();
+            break;
+        }
+        return true;
+    }
+    void nextElement() {
+        if (!frames.empty() && !frames.back().object) ++frames.back().index;
+    }
+    std::string path() const {
+        std::string p;
+        for (const Frame& f : frames)
+            p += "/" + (f.object ? f.key : std::to_string(f.index));
+        return p;
+    }
+};
+
+} // namespace
+
 StrokeScript parseStrokeScript(const std::string& text, const std::string& name) {
     const Reader r(name);
     json root;
+    DuplicateKeys duplicates;
     try {
-        root = json::parse(text);
+        root = json::parse(text, std::ref(duplicates));
     } catch (const json::parse_error& e) {
         const auto [line, col] = lineAndColumn(text, e.byte == 0 ? 0 : e.byte - 1);
         std::string why = e.what();
@@ -289,6 +347,9 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name)
         throw ScriptError(name + ": line " + std::to_string(line) + ", column " +
                           std::to_string(col) + ": the number " + token + " is not finite");
     }
+    if (!duplicates.first.empty())
+        throw ScriptError(name + ": " + duplicates.first +
+                          " appears twice in the same object (which one is meant?)");
     r.onlyKeys(root, "", {"sweepers", "grid", "start", "strokes"});
     StrokeScript s;
     const json& version = r.require(root, "", "sweepers");

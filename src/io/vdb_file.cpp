@@ -5,10 +5,23 @@
 
 #include <openvdb/io/File.h>
 
+#include "core/format.h"
 #include "io/atomic_file.h"
 #include "levelset/create.h"
 
 namespace sweepers {
+
+namespace {
+
+// Values (active or not, in leaves and tiles) that are NaN or infinite.
+std::size_t nonFiniteValues(const Grid& grid) {
+    std::size_t bad = 0;
+    for (auto it = grid.cbeginValueAll(); it; ++it)
+        bad += !std::isfinite(*it);
+    return bad;
+}
+
+} // namespace
 
 GridPtr readLevelSet(const std::string& path) {
     initVdb();
@@ -36,7 +49,10 @@ GridPtr readLevelSet(const std::string& path) {
         const double hw = halfWidthOf(*grid);
         if (!(hw >= kMinHalfWidth - 1e-6))
             throw FileError(path + ": grid '" + grid->getName() + "' has a band of " +
-                            std::to_string(hw) + " voxels; Sweepers needs at least 2");
+                            formatNumber(hw) + " voxels; Sweepers needs at least 2");
+        if (const std::size_t bad = nonFiniteValues(*grid))
+            throw FileError(path + ": grid '" + grid->getName() + "' holds " + std::to_string(bad) +
+                            " values that are not finite numbers");
         markAsDocument(*grid);
         return grid;
     }

@@ -1,0 +1,18 @@
+#include "core/memory.h"
+
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+namespace sweepers {
+
+double availableMemoryBytes() {
+    std::ifstream info("/proc/meminfo");
+    std::string line;
+    double kib = 0.0;
+    while (std::getline(info, line))
+        if (std::sscanf(line.c_str(), "MemAvailable: %lf kB", &kib) == 1) return kib * 1024.0;
+    return 0.0;
+}
+
+} // namespace sweepers

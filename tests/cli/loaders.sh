@@ -1,0 +1,139 @@
+#!/usr/bin/env bash
+# Files we did not write cannot take sweepers-cli down: broken meshes (indices out of
+# range or negative, non-finite or enormous coordinates, a header announcing 2^31
+# vertices, an open surface), level sets with non-finite values or no surface, scripts with
+# duplicate keys or impossible sizes each get one line that says what is wrong, a non-zero
+# exit and no output; then a fixed corpus of damaged PLY, OBJ, STL and JSON files must each
+# end in success or such a refusal, within a time bound, never a crash.
+set -euo pipefail
+cli=$1
+data=$2
+here=$(cd "$(dirname "$0")" && pwd)
+py=/usr/bin/python3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+cd "$tmp"
+
+# Runs the CLI expecting a refusal whose one line contains `message`, and no output file.
+refuses() {
+  local message=$1
+  shift
+  local rc=0
+  timeout 60 "$cli" "$@" -o out.vdb >/dev/null 2>err || rc=$?
+  [ "$rc" = 1 ] || fail "$*: exit $rc, expected 1 ($(cat err))"
+  [ "$(wc -l <err)" = 1 ] || fail "$*: expected one line, got: $(cat err)"
+  grep -qF "$message" err || fail "$*: expected '$message', got: $(cat err)"
+  [ ! -e out.vdb ] || fail "$*: wrote out.vdb"
+}
+script_for() { # a script starting from mesh file $1 at voxel size $2
+  printf '{"sweepers": 1, "grid": {"voxel_size": %s, "half_width": 3}, "start": {"mesh": "%s"}, "strokes": []}\n' "$2" "$1" >"$1.json"
+}
+
+# --- hand-made broken meshes -----------------------------------------------------------------
+"$py" - <<'PY'
+def ply(name, verts, faces, count=None):
+    with open(name, "w") as f:
+        f.write("ply\nformat ascii 1.0\nelement vertex %d\nproperty float x\nproperty float y\n"
+                "property float z\nelement face %d\nproperty list uchar int vertex_indices\n"
+                "end_header\n" % (len(verts) if count is None else count, len(faces)))
+        f.writelines("%s %s %s\n" % v for v in verts)
+        f.writelines("3 %d %d %d\n" % t for t in faces)
+V = [(-0.5, -0.5, -0.5), (0.5, -0.5, -0.5), (0, 0.5, -0.5), (0, 0, 0.5)]
+F = [(0, 2, 1), (0, 1, 3), (1, 2, 3), (2, 0, 3)]
+ply("good.ply", V, F)
+ply("past_end.ply", V, F[:3] + [(2, 0, 99)])
+ply("negative.ply", V, F[:3] + [(2, 0, -5)])
+ply("infinite.ply", V[:3] + [("inf", "0", "0.5")], F)
+ply("nan.ply", V[:3] + [("nan", "0", "0.5")], F)
+ply("enormous.ply", [(x * 1e3, y * 1e3, z * 1e3) for x, y, z in V], F)
+ply("announces.ply", V, F, count=2**31)
+ply("open.ply", V, F[:3])
+PY
+for f in good past_end negative infinite nan enormous announces open; do script_for $f.ply 0.05; done
+"$cli" apply good.ply.json -q -o good.vdb || fail "the good tetrahedron was refused"
+refuses "face 3 refers to vertex 99, but the mesh has 4 vertices" apply past_end.ply.json -q
+refuses "face 3 refers to vertex -5, but the mesh has 4 vertices" apply negative.ply.json -q
+refuses "1 vertices have coordinates that are not finite numbers" apply infinite.ply.json -q
+refuses "1 vertices have coordinates that are not finite numbers" apply nan.ply.json -q
+refuses "the start shape needs about" apply enormous.ply.json -q
+grep -q "more than the .* available; use a coarser voxel size, or --force" err ||
+  fail "the memory refusal does not say what to do: $(cat err)"
+refuses "the file announces more data than memory can hold" apply announces.ply.json -q
+refuses "the mesh is not closed (3 edges border a single triangle), so it has no inside" \
+  apply open.ply.json -q
+
+# --- level sets: non-finite values, no surface --------------------------------------------
+"$cli" new -o sphere.vdb --voxel-size 0.1 --radius 0.5
+"$py" - <<'PY'
+import pyopenvdb as vdb
+g = vdb.read("sphere.vdb", "surface")
+acc, n = g.getAccessor(), 0
+for it in g.iterOnValues():
+    if it.count == 1 and n < 5:
+        acc.setValueOnly(it.min, float("nan"))
+        n += 1
+vdb.write("nan.vdb", grids=[g])
+e = vdb.FloatGrid(0.3)
+e.name, e.gridClass = "surface", vdb.GridClass.LEVEL_SET
+e.transform = vdb.createLinearTransform(voxelSize=0.1)
+vdb.write("empty.vdb", grids=[e])
+PY
+rc=0
+"$cli" info nan.vdb 2>err >/dev/null || rc=$?
+[ "$rc" = 1 ] && grep -qF "holds 5 values that are not finite numbers" err ||
+  fail "a grid with NaN values: exit $rc, $(cat err)"
+"$cli" info empty.vdb | grep -q "bbox empty (no active voxels)" || fail "info on an empty level set"
+rc=0
+"$cli" mesh empty.vdb -o empty.ply 2>err || rc=$?
+[ "$rc" = 1 ] && grep -qF "nothing to write: the surface is empty" err && [ ! -e empty.ply ] ||
+  fail "mesh of an empty level set: exit $rc, $(cat err)"
+
+# --- scripts: duplicate keys, sizes check refuses as apply does ---------------------------
+printf '{"sweepers": 1, "grid": {"voxel_size": 0.05, "voxel_size": 0.1, "half_width": 3}, "start": {"sphere": {"center": [0, 0, 0], "radius": 1}}, "strokes": []}' >dup.json
+for cmd in check apply; do
+  rc=0
+  "$cli" $cmd dup.json $([ $cmd = apply ] && echo "-o out.vdb") 2>err >/dev/null || rc=$?
+  [ "$rc" = 1 ] && grep -qF "/grid/voxel_size appears twice in the same object" err ||
+    fail "$cmd with a duplicate key: exit $rc, $(cat err)"
+done
+for size in 1e308 0.00001; do
+  printf '{"sweepers": 1, "grid": {"voxel_size": %s, "half_width": 3}, "start": {"sphere": {"center": [0, 0, 0], "radius": 1}}, "strokes": []}' $size >size.json
+  rc=0
+  "$cli" check size.json 2>check.err >/dev/null || rc=$?
+  "$cli" apply size.json -o out.vdb 2>apply.err >/dev/null && fail "apply took voxel size $size"
+  [ "$rc" = 1 ] && cmp -s check.err apply.err ||
+    fail "voxel size $size: check says '$(cat check.err)', apply says '$(cat apply.err)'"
+  [ "$(wc -c <check.err)" -lt 240 ] || fail "a long refusal: $(cat check.err)"
+done
+
+# --- a fixed corpus of damaged files ---------------------------------------------------------
+"$cli" new -o small.vdb --voxel-size 0.1 --radius 0.5
+for ext in ply obj stl; do "$cli" mesh small.vdb -o "small.$ext" 2>/dev/null; done
+for ext in ply obj stl; do "$py" "$here/mutate.py" "small.$ext" corpus 40 7; done
+"$py" "$here/mutate.py" "$data/horn.json" corpus 60 7
+declare -A outcome
+for f in corpus/*; do
+  case $f in
+  *.json) args=(check "$f") ;;
+  *) script_for "$(basename "$f")" 0.05 && mv "$(basename "$f").json" corpus.json &&
+       args=(apply corpus.json -q -o corpus.vdb) ;;
+  esac
+  ln -sf "$f" "$(basename "$f")" # the script names the file beside it
+  rc=0
+  timeout 30 "$cli" "${args[@]}" >/dev/null 2>err || rc=$?
+  ext=${f##*.}
+  if [ "$rc" = 0 ]; then
+    outcome[$ext.read]=$((${outcome[$ext.read]:-0} + 1))
+  elif [ "$rc" = 1 ] && [ "$(wc -l <err)" = 1 ] && grep -q '^sweepers-cli: .*[a-z] [a-z]' err &&
+    ! grep -qE '^sweepers-cli: (std::)?[a-z_:]+$' err; then
+    outcome[$ext.refused]=$((${outcome[$ext.refused]:-0} + 1))
+  else
+    fail "$f: exit $rc ($( [ "$rc" -gt 128 ] && echo "signal $((rc - 128))"; [ "$rc" = 124 ] && echo "timed out")) $(head -c 300 err)"
+  fi
+  rm -f "$(basename "$f")" corpus.vdb
+done
+for ext in ply obj stl json; do
+  echo "damaged $ext: ${outcome[$ext.read]:-0} read, ${outcome[$ext.refused]:-0} refused in one line"
+done
+echo "loaders: every broken file refused cleanly"
