@@ -2,11 +2,13 @@
 
 #include <cmath>
 #include <fstream>
+#include <new>
 
 #include <openvdb/io/File.h>
 
 #include "core/format.h"
 #include "io/atomic_file.h"
+#include "io/isolated_read.h"
 #include "levelset/create.h"
 
 namespace sweepers {
@@ -24,14 +26,21 @@ std::size_t nonFiniteValues(const Grid& grid) {
 } // namespace
 
 GridPtr readLevelSet(const std::string& path) {
+    if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
+    return readLevelSetInChild(path);
+}
+
+GridPtr readLevelSetInProcess(const std::string& path) {
     initVdb();
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
     openvdb::GridPtrVecPtr grids;
     try {
         openvdb::io::File file(path);
-        file.open();
+        file.open(/*delayLoad=*/false); // no memory map, no temporary copy: read it all now
         grids = file.getGrids();
         file.close();
+    } catch (const std::bad_alloc&) {
+        throw; // (in the reader's child process: its memory limit)
     } catch (const std::exception& e) {
         throw FileError(path + ": not a readable VDB file (" + e.what() + ")");
     }

@@ -18,7 +18,11 @@ class FileError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
+// Reads the level set in a child process (io/isolated_read.h): a damaged file cannot crash
+// or hang the caller. Throws FileError saying what is wrong.
 GridPtr readLevelSet(const std::string& path);
+// The reader itself, in this process: for files we wrote, and for that child.
+GridPtr readLevelSetInProcess(const std::string& path);
 // Atomic (io/atomic_file.h): a failed write, a full disk included, keeps the old file.
 void writeLevelSet(const Grid& grid, const std::string& path);
 // The same, written and flushed but not yet in place: commit() puts it there.

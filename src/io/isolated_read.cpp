@@ -1,0 +1,189 @@
+#include "io/isolated_read.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <csignal>
+#include <cstring>
+#include <fstream>
+#include <new>
+#include <sstream>
+#include <vector>
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <openvdb/io/Stream.h>
+
+#include "core/format.h"
+#include "core/memory.h"
+#include "core/stopwatch.h"
+#include "io/vdb_file.h"
+
+namespace sweepers {
+
+namespace {
+
+constexpr const char* kMarker = "--sweepers-read-level-set-for-parent";
+// Child exit codes besides 0 (the grid was sent) and 1 (a refusal was sent).
+constexpr int kOutOfMemory = 3, kCannotStart = 127;
+// The child's descriptors for the grid and for a refusal (its stdout and stderr go nowhere).
+constexpr int kGridFd = 3, kMessageFd = 4;
+
+void writeAll(int fd, const std::string& bytes) {
+    std::size_t done = 0;
+    while (done < bytes.size()) {
+        const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) ::_exit(kCannotStart);
+        done += std::size_t(n);
+    }
+}
+
+// The child's side: runs when the executable was started with the marker.
+bool serveReadIfAsked() {
+    std::ifstream cmdline("/proc/self/cmdline", std::ios::binary);
+    std::vector<std::string> args;
+    for (std::string arg; std::getline(cmdline, arg, '\0');)
+        args.push_back(arg);
+    if (args.size() != 3 || args[1] != kMarker) return false;
+    try {
+        const GridPtr grid = readLevelSetInProcess(args[2]);
+        std::ostringstream out;
+        openvdb::io::Stream(out).write(openvdb::GridCPtrVec{grid});
+        writeAll(kGridFd, out.str());
+        ::_exit(0);
+    } catch (const std::bad_alloc&) {
+        ::_exit(kOutOfMemory);
+    } catch (const std::exception& e) {
+        writeAll(kMessageFd, e.what());
+        ::_exit(1);
+    }
+}
+
+const bool gServed = serveReadIfAsked();
+
+// What the reader may use: a file expands when it is decompressed, but not without bound;
+// a damaged size field can ask for gigabytes. Generous for real files (64 times the file,
+// 2 GB at least, counting the process's own mappings), never more than is available.
+double readerMemory(const std::string& path) {
+    struct stat st {};
+    const double file = ::stat(path.c_str(), &st) == 0 ? double(st.st_size) : 0.0;
+    const double available = availableMemoryBytes();
+    const double wanted = std::max(2e9, 64.0 * file);
+    return available > 0 ? std::min(wanted, available) : wanted;
+}
+
+std::string selfPath() {
+    std::vector<char> buf(4096);
+    const ssize_t n = ::readlink("/proc/self/exe", buf.data(), buf.size() - 1);
+    if (n <= 0) throw FileError("cannot start the file reader (no /proc/self/exe)");
+    return std::string(buf.data(), std::size_t(n));
+}
+
+} // namespace
+
+GridPtr readLevelSetInChild(const std::string& path, const ReadLimits& limits) {
+    (void)gServed;
+    initVdb();
+    const std::string self = selfPath();
+    int out[2], err[2];
+    if (::pipe2(out, O_CLOEXEC) != 0) throw FileError("cannot start the file reader (pipe)");
+    if (::pipe2(err, O_CLOEXEC) != 0) {
+        ::close(out[0]);
+        ::close(out[1]);
+        throw FileError("cannot start the file reader (pipe)");
+    }
+    const double bytes = limits.bytes > 0 ? limits.bytes : readerMemory(path);
+    std::vector<const char*> argv{self.c_str(), kMarker, path.c_str(), nullptr};
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+        // Only async-signal-safe calls until exec.
+        // Moved above the targets first, so that neither dup2 overwrites the other's source.
+        const int grid = ::fcntl(out[1], F_DUPFD_CLOEXEC, 10);
+        const int message = ::fcntl(err[1], F_DUPFD_CLOEXEC, 10);
+        // What the libraries print (OpenVDB's warnings, glibc's last words) is not for the
+        // user: the parent says in one line what happened.
+        const int null = ::open("/dev/null", O_WRONLY);
+        ::dup2(null, STDOUT_FILENO);
+        ::dup2(null, STDERR_FILENO);
+        ::dup2(grid, kGridFd);
+        ::dup2(message, kMessageFd);
+#if !defined(__SANITIZE_ADDRESS__)
+        // (AddressSanitizer reserves terabytes of address space: no limit there.)
+        if (bytes > 0) {
+            const rlimit as{rlim_t(bytes), rlim_t(bytes)};
+            ::setrlimit(RLIMIT_AS, &as);
+        }
+#endif
+        ::execv(self.c_str(), const_cast<char* const*>(argv.data()));
+        ::_exit(kCannotStart);
+    }
+    ::close(out[1]);
+    ::close(err[1]);
+    if (pid < 0) {
+        ::close(out[0]);
+        ::close(err[0]);
+        throw FileError("cannot start the file reader (fork)");
+    }
+    // Collect both pipes until they close or the time is up.
+    std::string grid, message;
+    pollfd fds[2] = {{out[0], POLLIN, 0}, {err[0], POLLIN, 0}};
+    std::string* sinks[2] = {&grid, &message};
+    const auto start = Clock::now();
+    bool timedOut = false;
+    int open = 2;
+    std::vector<char> chunk(1 << 16);
+    while (open > 0) {
+        const double left = limits.seconds - secondsSince(start);
+        if (left <= 0) {
+            timedOut = true;
+            break;
+        }
+        const int ready = ::poll(fds, 2, int(std::min(left, 1.0) * 1000) + 1);
+        if (ready < 0 && errno != EINTR) break;
+        for (int k = 0; k < 2; ++k) {
+            if (fds[k].fd < 0 || !(fds[k].revents & (POLLIN | POLLHUP | POLLERR))) continue;
+            const ssize_t n = ::read(fds[k].fd, chunk.data(), chunk.size());
+            if (n > 0) {
+                sinks[k]->append(chunk.data(), std::size_t(n));
+            } else if (n == 0 || errno != EINTR) {
+                ::close(fds[k].fd);
+                fds[k].fd = -1;
+                --open;
+            }
+        }
+    }
+    for (const pollfd& f : fds)
+        if (f.fd >= 0) ::close(f.fd);
+    if (timedOut) ::kill(pid, SIGKILL);
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (timedOut)
+        throw FileError(path + ": the file seems damaged: reading it did not finish in " +
+                        formatNumber(limits.seconds) + " s");
+    if (WIFSIGNALED(status))
+        throw FileError(path + ": the file is damaged: the VDB reader crashed on it (" +
+                        std::string(::strsignal(WTERMSIG(status))) + ")");
+    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : kCannotStart;
+    if (code == kOutOfMemory)
+        throw FileError(path + ": the file seems damaged: reading it would take more than " +
+                        formatBytes(bytes) + " of memory");
+    if (code == 1) throw FileError(message);
+    if (code != 0) throw FileError(path + ": cannot start the file reader");
+    try {
+        std::istringstream in(grid);
+        openvdb::io::Stream stream(in, /*delayLoad=*/false);
+        const openvdb::GridPtrVecPtr grids = stream.getGrids();
+        GridPtr g = grids && !grids->empty() ? openvdb::gridPtrCast<Grid>(grids->front()) : nullptr;
+        if (g) return g;
+    } catch (const std::exception& e) {
+    }
+    throw FileError(path + ": the file reader returned no grid");
+}
+
+} // namespace sweepers

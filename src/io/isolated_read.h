@@ -1,0 +1,30 @@
+// Reading level-set files we did not write in a child process. OpenVDB's reader can
+// crash, loop or allocate without bound on a damaged file; in a child with a time and a
+// memory limit the worst it can do is end that child, and the caller gets a FileError in
+// one line while its own work (a modeler session) goes on.
+//
+// The child is this same executable, started again with a marker argument: a static
+// initializer of this module sees the marker before main() runs, reads the file with the
+// in-process reader, sends the validated grid back through a pipe in OpenVDB's stream
+// format (which the parent reads safely: we wrote it) and exits. Every executable that
+// links the io layer can therefore serve as its own reader, tests included.
+#pragma once
+
+#include <string>
+
+#include "levelset/vdb.h"
+
+namespace sweepers {
+
+struct ReadLimits {
+    double seconds = 120.0; // wall clock for the whole read
+    double bytes = 0.0;     // address space of the child; 0: 64 times the file, at least
+                            // 2 GB, at most the memory available
+};
+
+// readLevelSetInProcess(path) (io/vdb_file.h) in a child process. Throws FileError with
+// the child's own message when it refuses the file, or saying that the file is damaged
+// when the child crashed, ran out of time or of memory.
+GridPtr readLevelSetInChild(const std::string& path, const ReadLimits& limits = {});
+
+} // namespace sweepers
