@@ -110,6 +110,7 @@ void removeLeftovers(const std::string& path) {
         const std::string name = e->d_name;
         if (name.compare(0, prefix.size(), prefix) != 0) continue;
         const std::string rest = name.substr(prefix.size());
+        const std::string full = dir + '/' += name;
         const auto dash = rest.find('-');
         bool stale = false;
         if (dash != std::string::npos && dash > 0 && rest.find_first_not_of("0123456789") == dash &&
@@ -118,10 +119,9 @@ void removeLeftovers(const std::string& path) {
             stale = pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH;
         } else if (rest.size() == 6 && dash == std::string::npos) {
             struct stat st {};
-            const std::string full = dir + "/" + name;
             stale = ::stat(full.c_str(), &st) == 0 && std::time(nullptr) - st.st_mtime > 3600;
         }
-        if (stale) ::unlink((dir + "/" + name).c_str());
+        if (stale) ::unlink(full.c_str());
     }
     ::closedir(d);
 }

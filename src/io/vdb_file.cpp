@@ -78,7 +78,7 @@ namespace {
 class FileWriter : public openvdb::io::Archive {
   public:
     openvdb::io::Archive::Ptr copy() const override { return std::make_shared<FileWriter>(*this); }
-    void write(std::ostream& out, const openvdb::GridCPtrVec& grids) const {
+    void writeTo(std::ostream& out, const openvdb::GridCPtrVec& grids) const {
         Archive::write(out, grids, /*seekable=*/true);
     }
 };
@@ -91,7 +91,7 @@ AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path) {
     markAsDocument(*copy);
     copy->insertMeta("voxel_size", openvdb::FloatMetadata(float(grid.voxelSize()[0])));
     return AtomicWrite(
-        path, [&](std::ostream& out) { FileWriter().write(out, openvdb::GridCPtrVec{copy}); });
+        path, [&](std::ostream& out) { FileWriter().writeTo(out, openvdb::GridCPtrVec{copy}); });
 }
 
 void writeLevelSet(const Grid& grid, const std::string& path) {

@@ -7,7 +7,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
-#include <queue>
+#include <stdexcept>
 #include <type_traits>
 #include <unordered_map>
 #include <vector>
@@ -210,15 +210,20 @@ class MarchQueue {
 // Heap pops between two polls of the interrupter.
 constexpr std::size_t kPollEvery = 1 << 14;
 
+// Queue entries hold a voxel's index in 32 bits.
+std::size_t indexable(std::size_t voxels) {
+    if (voxels >= (std::size_t(1) << 32))
+        throw std::length_error("renormalization: the region holds too many voxels");
+    return voxels;
+}
+
 class Marcher {
   public:
     Marcher(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
             FmmOrder order, Interrupter* interrupter)
-        : b_(grid, region, 2), n_(b_.size()), h_(float(grid.voxelSize()[0])),
+        : b_(grid, region, 2), n_(indexable(b_.size())), h_(float(grid.voxelSize()[0])),
           bg_(grid.background()), order_(order), interrupter_(interrupter), phi_(n_), cells_(n_),
           thin_(n_, 0) {
-        if (n_ >= (std::size_t(1) << 32))
-            throw std::length_error("renormalization: the region holds too many voxels");
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);

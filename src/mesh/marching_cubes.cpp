@@ -48,7 +48,7 @@ class LeafBlock {
 
   private:
     openvdb::Coord origin_;
-    std::array<float, kSpan * kSpan * kSpan> values_;
+    std::array<float, std::size_t(kSpan) * kSpan * kSpan> values_;
 };
 
 MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
