@@ -155,14 +155,20 @@ void reportMeshWritten(const std::string& path, const TriangleMesh& mesh) {
                  mesh.positions.size(), mesh.triangles.size());
 }
 
-void exportMesh(const Grid& grid, const std::string& path) {
-    const TriangleMesh mesh = meshLevelSet(grid);
+// The surface as exported: y up as the modeler shows it, or turned so that z is up.
+TriangleMesh exportedMesh(const Grid& grid, const std::string& up) {
+    TriangleMesh mesh = meshLevelSet(grid);
+    return up == "z" ? zUp(std::move(mesh)) : mesh;
+}
+
+void exportMesh(const Grid& grid, const std::string& path, const std::string& up) {
+    const TriangleMesh mesh = exportedMesh(grid, up);
     writeMesh(mesh, path);
     reportMeshWritten(path, mesh);
 }
 
 struct ApplyArgs {
-    std::string script, output, mesh;
+    std::string script, output, mesh, up = "y";
     double voxelSize = 0.0;
     bool perSubStep = false, quiet = false, firstOrder = false, stats = false, cubic = false,
          force = false;
@@ -221,7 +227,7 @@ int runApply(const ApplyArgs& a) {
     std::optional<AtomicWrite> meshFile;
     TriangleMesh mesh;
     if (!a.mesh.empty()) {
-        mesh = meshLevelSet(grid);
+        mesh = exportedMesh(grid, a.up);
         meshFile.emplace(prepareMesh(mesh, a.mesh));
     }
     vdb.commit();
@@ -272,6 +278,11 @@ static int run(int argc, char** argv) {
     apply->add_option("-o,--output", applyArgs.output, "Output .vdb")->required();
     apply->add_option("--voxel-size", applyArgs.voxelSize, "Override the script's voxel size");
     apply->add_option("--mesh", applyArgs.mesh, "Also export the surface (.obj, .ply, .stl)");
+    apply
+        ->add_option("--up", applyArgs.up,
+                     "The mesh's up axis: y (as shown) or z (Blender's "
+                     "PLY and STL importers, CAD tools)")
+        ->check(CLI::IsMember({"y", "z"}));
     apply->add_flag("--resample-each-substep", applyArgs.perSubStep,
                     "Resample after every sub-step (the thesis's 5.3.4; blurrier)");
     apply->add_flag("--first-order", applyArgs.firstOrder, "First-order fast marching");
@@ -293,6 +304,11 @@ static int run(int argc, char** argv) {
     CLI::App* mesh = app.add_subcommand("mesh", "Export the surface of a level-set VDB file");
     mesh->add_option("file", path, "Level-set .vdb")->required();
     mesh->add_option("-o,--output", output, "Output mesh (.obj, .ply, .stl)")->required();
+    std::string up = "y";
+    mesh->add_option("--up", up,
+                     "Up axis: y (as shown) or z (Blender's PLY and STL importers, "
+                     "CAD tools)")
+        ->check(CLI::IsMember({"y", "z"}));
 
     try {
         app.parse(argc, argv);
@@ -324,7 +340,7 @@ static int run(int argc, char** argv) {
         if (*mesh) {
             requireMeshPath(output);
             requireWritable(output);
-            exportMesh(*readLevelSet(path), output);
+            exportMesh(*readLevelSet(path), output, up);
             return 0;
         }
     } catch (const Cancelled&) {

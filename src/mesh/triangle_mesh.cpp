@@ -55,6 +55,16 @@ double enclosedVolume(const TriangleMesh& mesh) {
     return enclosedVolume(mesh.positions, mesh.triangles);
 }
 
+TriangleMesh zUp(TriangleMesh mesh) {
+    // (x, y, z) -> (x, -z, y): a rotation, so orientation and normals stay consistent.
+    const auto turn = [](Eigen::Vector3f& v) { v = Eigen::Vector3f(v.x(), -v.z(), v.y()); };
+    for (Eigen::Vector3f& p : mesh.positions)
+        turn(p);
+    for (Eigen::Vector3f& n : mesh.normals)
+        turn(n);
+    return mesh;
+}
+
 double surfaceArea(const TriangleMesh& mesh) {
     double s = 0.0;
     for (const Eigen::Vector3i& t : mesh.triangles) {

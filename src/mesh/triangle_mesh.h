@@ -35,4 +35,8 @@ double enclosedVolume(const std::vector<Eigen::Vector3f>& positions,
                       const std::vector<Eigen::Vector3i>& triangles);
 double surfaceArea(const TriangleMesh& mesh);
 
+// The mesh turned a quarter turn about x, so that our up axis (y) becomes z: for tools
+// whose importers take z as up (Blender's PLY and STL importers, most CAD tools).
+TriangleMesh zUp(TriangleMesh mesh);
+
 } // namespace sweepers

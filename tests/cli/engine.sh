@@ -133,4 +133,22 @@ grep -q "interrupted; nothing was written" "$tmp/err" || { cat "$tmp/err"; fail 
 [ ! -e "$tmp/cancelled.vdb" ] || fail "interrupted apply: left its output"
 ls "$tmp" | grep -q "tmp-" && fail "interrupted apply: left a temporary file"
 echo "interrupted apply: $(cat "$tmp/err")"
+
+# --- --up z: the same surface turned so that z is up ((x, y, z) -> (x, -z, y)) -----------
+"$cli" mesh "$tmp/sphere.vdb" -o "$tmp/y.obj" 2>/dev/null
+"$cli" mesh "$tmp/sphere.vdb" -o "$tmp/z.obj" --up z 2>/dev/null
+"$py" - "$tmp/y.obj" "$tmp/z.obj" <<'PY'
+import sys
+def lines(path, tag):
+    return [list(map(float, l.split()[1:4])) for l in open(path) if l.startswith(tag + " ")]
+for tag in ("v", "vn"):
+    a, b = lines(sys.argv[1], tag), lines(sys.argv[2], tag)
+    assert len(a) == len(b) > 0, (tag, len(a), len(b))
+    for (x, y, z), (u, v, w) in zip(a, b):
+        assert abs(u - x) < 1e-6 and abs(v + z) < 1e-6 and abs(w - y) < 1e-6, (tag, x, y, z, u, v, w)
+faces = lambda p: [l for l in open(p) if l.startswith("f ")]
+assert faces(sys.argv[1]) == faces(sys.argv[2]), "the triangles changed"
+PY
+if "$cli" mesh "$tmp/sphere.vdb" -o "$tmp/x.obj" --up x 2>/dev/null; then fail "--up x accepted"; fi
+
 echo "engine cli: ok"
