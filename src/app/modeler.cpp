@@ -15,6 +15,7 @@
 #include <future>
 #include <memory>
 #include <optional>
+#include <ostream>
 #include <stdexcept>
 
 #include <backends/imgui_impl_glfw.h>
@@ -474,13 +475,14 @@ class Modeler {
         glReadBuffer(GL_BACK);
         glReadPixels(0, 0, fw, fh, GL_RGB, GL_UNSIGNED_BYTE, px.data());
         stbi_flip_vertically_on_write(1);
-        // Atomic: a temporary beside the target, renamed when complete.
-        const std::string tmp = path + ".tmp";
-        if (!stbi_write_png(tmp.c_str(), fw, fh, 3, px.data(), fw * 3) ||
-            std::rename(tmp.c_str(), path.c_str()) != 0) {
-            std::remove(tmp.c_str());
-            throw std::runtime_error(path + ": cannot write the screenshot");
-        }
+        // Encoded into the checked atomic save, like every other file we write.
+        writeFileAtomically(path, [&](std::ostream& out) {
+            const auto put = [](void* stream, void* data, int size) {
+                static_cast<std::ostream*>(stream)->write(static_cast<const char*>(data), size);
+            };
+            if (!stbi_write_png_to_func(put, &out, fw, fh, 3, px.data(), fw * 3))
+                throw std::runtime_error(path + ": cannot encode the screenshot");
+        });
     }
 
     struct Job {

@@ -13,7 +13,6 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
-#include "core/format.h"
 #include "io/atomic_file.h"
 #include "io/mesh_file.h"
 #include "io/start_grid.h"
@@ -326,9 +325,7 @@ static int run(int argc, char** argv) {
         if (*info) return runInfo(path, asJson);
         if (*apply) return runApply(applyArgs);
         if (*create) {
-            if (!(radius / voxelSize >= 1.5 && radius / voxelSize <= 1e5))
-                throw std::runtime_error("the sphere would be " + formatNumber(radius / voxelSize) +
-                                         " voxels in radius; use 1.5 to 100000");
+            requireSphereSize(radius, voxelSize);
             requireWritable(output);
             requireMemoryForBand(4.0 * M_PI * radius * radius, voxelSize, halfWidth,
                                  kSphereBytesPerVoxel, force);

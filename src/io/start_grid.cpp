@@ -28,6 +28,13 @@ void requireMemoryForBand(double area, double voxelSize, double halfWidth, doubl
                       " available; use a coarser voxel size, or --force to try anyway");
 }
 
+void requireSphereSize(double radius, double voxelSize) {
+    if (!(radius / voxelSize >= 1.5 && radius / voxelSize <= 1e5))
+        throw ScriptError("a sphere of radius " + formatNumber(radius) + " at voxel size " +
+                          formatNumber(voxelSize) + " is " + formatNumber(radius / voxelSize) +
+                          " voxels in radius; use 1.5 to 100000");
+}
+
 void requireBuildableStart(const StrokeScript& script, double voxelSize, bool force) {
     const double h = voxelSize > 0 ? voxelSize : script.grid.voxelSize;
     const double hw = script.grid.halfWidth;
@@ -35,10 +42,7 @@ void requireBuildableStart(const StrokeScript& script, double voxelSize, bool fo
         throw ScriptError("the band half-width must be at least 2 voxels for meshing");
     const StartShape& s = script.start;
     if (s.kind != StartShape::Kind::Sphere) return;
-    if (s.radius / h > 1e5 || s.radius / h < 1.5)
-        throw ScriptError("a sphere of radius " + formatNumber(s.radius) + " at voxel size " +
-                          formatNumber(h) + " is " + formatNumber(s.radius / h) +
-                          " voxels in radius; use 1.5 to 100000");
+    requireSphereSize(s.radius, h);
     requireMemoryForBand(4.0 * M_PI * s.radius * s.radius, h, hw, kSphereBytesPerVoxel, force);
 }
 

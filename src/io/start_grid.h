@@ -20,6 +20,9 @@ GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir,
 // a sphere its size in voxels and the memory its band needs. `check` makes them too.
 void requireBuildableStart(const StrokeScript& script, double voxelSize = 0.0, bool force = false);
 
+// Throws ScriptError unless the sphere is 1.5 to 100000 voxels in radius.
+void requireSphereSize(double radius, double voxelSize);
+
 // Peak memory per band voxel while a start is built (measured: a sphere about 28 bytes, a
 // mesh conversion 40 to 65), with some headroom.
 constexpr double kSphereBytesPerVoxel = 32.0, kMeshBytesPerVoxel = 64.0;
