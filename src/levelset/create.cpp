@@ -15,7 +15,12 @@ void initVdb() {
 openvdb::math::Transform::Ptr documentTransform(double voxelSize) {
     auto xform = openvdb::math::Transform::createLinearTransform(voxelSize);
     xform->postTranslate(openvdb::Vec3d(0.5 * voxelSize));
-    return xform;
+    // Every copy of a transform (Grid::deepCopy, reading a file) rebuilds its map through an
+    // affine matrix, which moves a voxel size like 1/24 by one unit in the last place; a
+    // second copy changes nothing. Documents start from that settled form, so a grid and its
+    // copies (a checkpoint read back, an undo snapshot) sample at the very same points and
+    // sculpt to the same voxels.
+    return xform->copy();
 }
 
 GridPtr makeSphere(const Eigen::Vector3d& center, double radius, double voxelSize,

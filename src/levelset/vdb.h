@@ -2,6 +2,8 @@
 // core. Everything from levelset/ up includes this instead of OpenVDB directly.
 #pragma once
 
+#include <cmath>
+
 #include <Eigen/Core>
 #include <openvdb/openvdb.h>
 
@@ -18,8 +20,12 @@ inline openvdb::Vec3d toVdb(const Eigen::Vector3d& v) {
 }
 
 // Half-width of a level set's band in voxels, from its background value.
+// The background is a float: background / voxel size misses the half-width set by a unit or
+// so in the seventh digit (2.99999993 voxels at voxel size 0.01), and a band widened by
+// ceil(needed - half-width) voxels would then get one more ring. Half-widths are whole or
+// simple fractions of a voxel: the quotient is rounded to 1/1024 of a voxel.
 inline double halfWidthOf(const Grid& grid) {
-    return double(grid.background()) / grid.voxelSize()[0];
+    return std::round(double(grid.background()) / grid.voxelSize()[0] * 1024.0) / 1024.0;
 }
 
 // Makes sure OpenVDB's grid registry is set up (idempotent, thread-safe).

@@ -7,6 +7,7 @@
 #include <openvdb/tools/Composite.h>
 
 #include "deform/inflate.h"
+#include "grids.h"
 #include "io/start_grid.h"
 #include "io/stroke_script.h"
 #include "levelset/advect.h"
@@ -199,4 +200,30 @@ TEST(Advect, ASegmentsWorkFollowsTheBrushNotTheModel) {
     for (auto it = box.begin(); it; ++it)
         differing += ca.getValue(*it) != cb.getValue(*it);
     EXPECT_EQ(differing, 0u);
+}
+
+// A grid's copy (Grid::deepCopy, a file read back) must sculpt to the same voxels as the
+// grid itself, at voxel sizes that are not powers of two too: copying a transform once
+// moved 1/24 by a unit in the last place, and with it every sample point and the band's
+// half-width (2.9999999999999996 voxels, so one more ring of widening).
+TEST(Advect, ACopyOfTheGridSculptsToTheSameVoxels) {
+    for (const double h : {1.0 / 24, 0.01}) {
+        Sculptor s(makeSphere({0, 0, 0}, 1.0, h, 3.0));
+        EXPECT_EQ(halfWidthOf(s.grid()), 3.0);
+        InflateStroke dab{{0, 1, 0}, 0.15};
+        s.applyStroke(dab);
+        Sculptor copy(s.grid().deepCopy());
+        EXPECT_EQ(copy.grid().voxelSize(), s.grid().voxelSize());
+        ToolSpec t;
+        t.size = Eigen::Vector3d::Constant(0.3);
+        t.falloff = 0.3;
+        Placement a, b;
+        a.t = {1, 0, 0};
+        b.t = {1.2, 0, 0};
+        t.path = {a, b};
+        const Stroke drag = SweepStroke{MirrorAxis::None, {t}};
+        s.applyStroke(drag);
+        copy.applyStroke(drag);
+        EXPECT_EQ(sweepers::test::differingVoxels(s.grid(), copy.grid()), 0u) << "h = " << h;
+    }
 }
