@@ -15,6 +15,10 @@ namespace sweepers {
 
 Document::Document(StrokeScript script, const std::string& scriptDir, const Progress& progress,
                    GridPtr start, Interrupter* interrupter)
+    : Document(std::move(script), scriptDir, progress, std::move(start), interrupter, 0) {}
+
+Document::Document(StrokeScript script, const std::string& scriptDir, const Progress& progress,
+                   GridPtr start, Interrupter* interrupter, std::size_t done)
     : script_(std::move(script)), scriptDir_(scriptDir),
       sculptor_(start ? std::move(start) : makeStartGrid(script_, scriptDir_, 0.0, interrupter)) {
     const double h = sculptor_.grid().voxelSize()[0];
@@ -23,8 +27,12 @@ Document::Document(StrokeScript script, const std::string& scriptDir, const Prog
         throw std::runtime_error(
             "the document starts from a VDB file at voxel size " + formatNumber(h) +
             "; it cannot be replayed at another voxel size (start from a sphere or a mesh)");
+    if (done > script_.strokes.size()) throw std::logic_error("more strokes done than there are");
     sculptor_.setInterrupter(interrupter);
-    applyStrokes(sculptor_, script_.strokes, progress);
+    applyStrokes(
+        sculptor_,
+        std::vector<Stroke>(script_.strokes.begin() + std::ptrdiff_t(done), script_.strokes.end()),
+        progress);
     markAsDocument(sculptor_.grid());
     sculptor_.startMeshing();
     sculptor_.setInterrupter(nullptr);
@@ -37,6 +45,11 @@ StrokeScript Document::sphereScript(double voxelSize) {
     s.start.kind = StartShape::Kind::Sphere;
     s.start.radius = 1.0;
     return s;
+}
+
+Document Document::resume(StrokeScript script, const std::string& scriptDir, GridPtr grid,
+                          std::size_t done, const Progress& progress, Interrupter* interrupter) {
+    return Document(std::move(script), scriptDir, progress, std::move(grid), interrupter, done);
 }
 
 Document Document::open(const std::string& path, double meshVoxelSize, const Progress& progress,
@@ -122,6 +135,7 @@ void Document::endEdit() {
     script_.strokes.insert(script_.strokes.end(), applied_.begin(), applied_.end());
     undo_.push_back({std::move(applied_), std::move(before)});
     applied_.clear();
+    if (listener_) listener_->appended(*this, undo_.back().strokes);
     redo_.clear();
     trimToBudget();
 }
@@ -144,6 +158,7 @@ void Document::undo() {
     undo_.pop_back();
     script_.strokes.resize(script_.strokes.size() - e.strokes.size());
     redo_.push_back(std::move(e));
+    if (listener_) listener_->truncated(*this, script_.strokes.size());
 }
 
 void Document::redo() {
@@ -153,6 +168,7 @@ void Document::redo() {
     redo_.pop_back();
     script_.strokes.insert(script_.strokes.end(), e.strokes.begin(), e.strokes.end());
     undo_.push_back(std::move(e));
+    if (listener_) listener_->appended(*this, undo_.back().strokes);
     trimToBudget();
 }
 
@@ -181,12 +197,7 @@ void Document::saveVdb(const std::string& path) {
 }
 
 void Document::saveScript(const std::string& path) {
-    // The start file is named so that the script works from wherever it is saved.
-    StrokeScript s = script_;
-    if (s.start.kind != StartShape::Kind::Sphere && !s.start.file.empty() &&
-        s.start.file.front() != '/')
-        s.start.file = std::filesystem::absolute(scriptDir_ + "/" + s.start.file).string();
-    writeStrokeScript(s, path);
+    writeStrokeScript(withAbsoluteStart(script_, scriptDir_), path);
 }
 
 Document Document::replayAt(StrokeScript script, const std::string& scriptDir, double voxelSize,

@@ -16,6 +16,20 @@
 
 namespace sweepers {
 
+class Document;
+
+// Told of every change to a document's history, in order, on the thread that made it (the
+// session journal listens).
+class HistoryListener {
+  public:
+    virtual ~HistoryListener() = default;
+    // An edit ended with these strokes (one undo step), or a redo put them back. The
+    // document's grid is the one after them.
+    virtual void appended(const Document& doc, const std::vector<Stroke>& strokes) = 0;
+    // An undo: the history keeps its first `strokes`.
+    virtual void truncated(const Document& doc, std::size_t strokes) = 0;
+};
+
 class Document {
   public:
     // Builds the script's start shape and applies its strokes (they become the document's
@@ -29,6 +43,11 @@ class Document {
     // (.obj, .ply, .stl) at `meshVoxelSize`.
     static Document open(const std::string& path, double meshVoxelSize = 1.0 / 64,
                          const Progress& progress = {}, Interrupter* interrupter = nullptr);
+    // A history continued from a grid that holds its first `done` strokes already (a
+    // checkpoint, when recovering a session).
+    static Document resume(StrokeScript script, const std::string& scriptDir, GridPtr grid,
+                           std::size_t done, const Progress& progress = {},
+                           Interrupter* interrupter = nullptr);
     // A history replayed at another voxel size (a resolution change).
     static Document replayAt(StrokeScript script, const std::string& scriptDir, double voxelSize,
                              const Progress& progress = {}, Interrupter* interrupter = nullptr);
@@ -38,6 +57,8 @@ class Document {
     // Polled while sculpting; may be changed between edits.
     void setInterrupter(Interrupter* interrupter) { sculptor_.setInterrupter(interrupter); }
     const StrokeScript& script() const { return script_; }
+    // Null: nobody is told.
+    void setHistoryListener(HistoryListener* listener) { listener_ = listener; }
     const std::string& scriptDir() const { return scriptDir_; }
 
     // Sculpting: a sweep of one tool whose path grows by one placement per drag event;
@@ -73,6 +94,8 @@ class Document {
     MeshChanges takeMeshChanges() { return sculptor_.mesher().takeChanges(); }
 
   private:
+    Document(StrokeScript script, const std::string& scriptDir, const Progress& progress,
+             GridPtr start, Interrupter* interrupter, std::size_t done);
     struct Edit {
         std::vector<Stroke> strokes;
         LeafSnapshot snapshot; // undo stack: before the strokes; redo stack: after them
@@ -91,6 +114,7 @@ class Document {
     bool inEdit_ = false, inStroke_ = false, modified_ = false;
     SweepStroke current_;
     std::vector<Stroke> applied_; // strokes of the edit in progress
+    HistoryListener* listener_ = nullptr;
 };
 
 } // namespace sweepers

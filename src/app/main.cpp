@@ -34,6 +34,16 @@ static int run(int argc, char** argv) {
                  "print stroke latency (drag event to mesh on screen) by stage at exit");
     app.add_option("--latency-csv", o.latencyCsv,
                    "write every segment's latency by stage (ms) to this CSV at exit");
+    app.add_option("--session-dir", o.sessionDir,
+                   "where sessions are kept for crash recovery (default "
+                   "$XDG_STATE_HOME/sweepers/sessions; replays and screenshots keep none "
+                   "unless this is given)");
+    app.add_flag("--recover", o.recover,
+                 "rebuild the document of the last session that ended in a crash, without "
+                 "asking");
+    app.add_option("--checkpoint-every", o.checkpointStrokes,
+                   "save a checkpoint of the grid every N strokes (default 20)")
+        ->check(CLI::Range(1, 1000000));
     app.add_option("--threads", threads, "worker threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
     CLI11_PARSE(app, argc, argv);

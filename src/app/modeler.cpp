@@ -27,6 +27,7 @@
 #include "app/gl_renderer.h"
 #include "app/input_replay.h"
 #include "app/sculpt_controller.h"
+#include "app/session.h"
 #include "core/format.h"
 #include "core/statistics.h"
 #include "core/stopwatch.h"
@@ -49,7 +50,27 @@ class Modeler {
         std::snprintf(path_, sizeof path_, "%s", o.open.empty() ? "untitled.vdb" : o.open.c_str());
         voxelSizeInput_ = float(o.voxelSize);
         syncViewport();
-        if (o.open.empty()) {
+        // Interrupted sessions are looked for before this one exists (its lock is held).
+        std::vector<std::string> interrupted;
+        if (!batch_ || !o.sessionDir.empty() || o.recover) {
+            const std::string root = o.sessionDir.empty() ? defaultSessionRoot() : o.sessionDir;
+            interrupted = interruptedSessions(root);
+            try {
+                SessionOptions so;
+                so.root = root;
+                so.checkpointStrokes = std::max<std::size_t>(1, o.checkpointStrokes);
+                session_ = std::make_unique<Session>(so);
+            } catch (const std::exception& e) {
+                std::fprintf(stderr, "sweepers: %s; strokes are not protected against a crash\n",
+                             e.what());
+            }
+        }
+        if (o.recover && interrupted.empty())
+            std::fprintf(stderr, "sweepers: there is no interrupted session to recover\n");
+        if (o.recover && !interrupted.empty()) {
+            setDocument(std::make_unique<Document>(Document::sphereScript(o.voxelSize), "."));
+            recover(interrupted.front());
+        } else if (o.open.empty()) {
             setDocument(std::make_unique<Document>(Document::sphereScript(o.voxelSize), "."));
         } else {
             const std::string path = o.open;
@@ -57,6 +78,19 @@ class Modeler {
             startJob("opening " + path, [path, h](const Progress& p, Interrupter* stop) {
                 return std::make_unique<Document>(Document::open(path, h, p, stop));
             });
+        }
+        if (!o.recover && !interrupted.empty() && !batch_) {
+            offerRecovery_ = interrupted.front();
+            try {
+                const JournalState st = readJournal(offerRecovery_);
+                offerText_ = "Sweepers stopped without closing, " +
+                             std::to_string(st.script.strokes.size()) +
+                             " strokes into a document. Recover it?";
+            } catch (const std::exception& e) {
+                offerText_ = "Sweepers stopped without closing, but its session cannot be "
+                             "recovered: " +
+                             std::string(e.what());
+            }
         }
     }
 
@@ -73,6 +107,13 @@ class Modeler {
                 replay.deliver(ctl_, [this](const InputEvent& e) { dispatch(e); });
                 ctl_.step();
                 takeFinished();
+            }
+            if (session_) {
+                const std::string problem = session_->takeError();
+                if (!problem.empty()) {
+                    status_ = problem;
+                    std::fprintf(stderr, "sweepers: %s\n", problem.c_str());
+                }
             }
             const auto drawStart = Clock::now();
             draw();
@@ -109,6 +150,8 @@ class Modeler {
         if (!opt_.latencyCsv.empty()) writeLatencyCsv(opt_.latencyCsv);
         if (!opt_.saveVdb.empty()) doc_->saveVdb(opt_.saveVdb);
         if (!opt_.saveScript.empty()) doc_->saveScript(opt_.saveScript);
+        // A clean end: the user saved or chose to discard (or a batch run wrote its files).
+        if (session_) session_->close();
         return 0;
     }
 
@@ -154,16 +197,18 @@ class Modeler {
         ctl_.setViewport(w, h);
     }
 
-    void setDocument(std::unique_ptr<Document> doc) {
+    void setDocument(std::unique_ptr<Document> doc, const Adoption& adopt = {}) {
         ctl_.setDocument(nullptr);
         doc_ = std::move(doc);
         ctl_.setDocument(doc_.get());
+        if (session_) session_->follow(*doc_, adopt);
         renderer_->update(doc_->mesher(), MeshChanges{true, {}});
         ctl_.frameView();
     }
 
     using Maker = std::function<std::unique_ptr<Document>(const Progress&, Interrupter*)>;
-    void startJob(const std::string& what, const Maker& make) {
+    void startJob(const std::string& what, const Maker& make,
+                  std::shared_ptr<Adoption> adopt = nullptr) {
         auto done = std::make_shared<std::atomic<std::size_t>>(0);
         auto total = std::make_shared<std::atomic<std::size_t>>(0);
         auto stop = std::make_shared<FlagInterrupter>();
@@ -173,7 +218,20 @@ class Modeler {
         };
         job_.emplace(Job{std::async(std::launch::async,
                                     [make, progress, stop] { return make(progress, stop.get()); }),
-                         done, total, stop, what});
+                         done, total, stop, what, std::move(adopt)});
+    }
+
+    // Rebuilds the document of an interrupted session off the render thread.
+    void recover(const std::string& dir) {
+        auto adopt = std::make_shared<Adoption>();
+        auto report = std::make_shared<std::string>();
+        recoveryReport_ = report;
+        startJob(
+            "recovering the session " + dir,
+            [dir, adopt, report](const Progress& p, Interrupter* stop) {
+                return recoverDocument(dir, *adopt, *report, p, stop);
+            },
+            adopt);
     }
 
     // Takes the finished job's document, or shows why there is none.
@@ -194,8 +252,13 @@ class Modeler {
             fail(e.what());
             return;
         }
-        setDocument(std::move(doc));
+        setDocument(std::move(doc), job.adopt ? *job.adopt : Adoption{});
         status_ = job.what + ": done";
+        if (job.adopt && recoveryReport_) {
+            status_ = *recoveryReport_;
+            std::fprintf(stderr, "sweepers: %s\n", recoveryReport_->c_str());
+            recoveryReport_.reset();
+        }
     }
 
     void confirm(const std::string& question, std::function<void()> action) {
@@ -449,6 +512,28 @@ class Modeler {
             }
             ImGui::EndPopup();
         }
+        if (!offerRecovery_.empty() && !job_) ImGui::OpenPopup("Recover");
+        if (ImGui::BeginPopupModal("Recover", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+            ImGui::TextWrapped("%s", offerText_.c_str());
+            ImGui::TextDisabled("%s", offerRecovery_.c_str());
+            if (ImGui::Button("Recover")) {
+                recover(offerRecovery_);
+                offerRecovery_.clear();
+                ImGui::CloseCurrentPopup();
+            }
+            ImGui::SameLine();
+            if (ImGui::Button("Discard it")) {
+                discardSession(offerRecovery_);
+                offerRecovery_.clear();
+                ImGui::CloseCurrentPopup();
+            }
+            ImGui::SameLine();
+            if (ImGui::Button("Ask again next time")) {
+                offerRecovery_.clear();
+                ImGui::CloseCurrentPopup();
+            }
+            ImGui::EndPopup();
+        }
         if (!confirmText_.empty()) ImGui::OpenPopup("Confirm");
         if (ImGui::BeginPopupModal("Confirm", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
             ImGui::Text("%s", confirmText_.c_str());
@@ -490,14 +575,19 @@ class Modeler {
         std::shared_ptr<std::atomic<std::size_t>> done, total;
         std::shared_ptr<FlagInterrupter> stop; // Esc or the Cancel button
         std::string what;
+        std::shared_ptr<Adoption> adopt; // a recovery: what the session takes over
     };
     bool batch_ = false;
     SculptController ctl_;
     ModelerOptions opt_;
     GLFWwindow* win_;
     std::optional<Job> job_;
+    std::unique_ptr<Session> session_; // declared before doc_: it outlives the document
     std::unique_ptr<Document> doc_;
     std::unique_ptr<GlRenderer> renderer_;
+    std::string offerRecovery_, offerText_; // an interrupted session the user has not
+                                            // decided about, and what the offer says
+    std::shared_ptr<std::string> recoveryReport_;
     double groundY_ = -1.0;
     struct Info {
         double voxelSize = 0;

@@ -1,6 +1,7 @@
 // The interactive modeler: a GLFW window over a Document, sculpted with the mouse.
 #pragma once
 
+#include <cstddef>
 #include <string>
 
 namespace sweepers {
@@ -17,6 +18,12 @@ struct ModelerOptions {
     bool hideUi = false;        // no panels (clean screenshots)
     bool latencyReport = false; // print per-segment latency by stage when the window closes
     std::string latencyCsv;     // ... and write every segment's figures here (ms)
+    // Crash safety (app/session.h): where sessions are kept (empty: the default place, and
+    // no session at all for batch runs: replays and screenshots); recover the newest
+    // interrupted session without asking; a checkpoint every this many strokes.
+    std::string sessionDir;
+    bool recover = false;
+    std::size_t checkpointStrokes = 20;
     std::string argv0;
 };
 

@@ -15,6 +15,7 @@
 
 #include "io/atomic_file.h"
 #include "io/mesh_file.h"
+#include "io/session_journal.h"
 #include "io/start_grid.h"
 #include "io/stroke_script.h"
 #include "io/vdb_file.h"
@@ -242,6 +243,32 @@ int runApply(const ApplyArgs& a) {
     return 0;
 }
 
+// Rebuilds the document of a modeler session that ended in a crash, as the modeler's
+// --recover does, and writes it; the session itself is left as it is.
+int runRecover(const std::string& where, const std::string& output, const std::string& script) {
+    requireWritable(output);
+    if (!script.empty()) requireWritable(script);
+    const std::string dir = sessionToRecover(where.empty() ? defaultSessionRoot() : where);
+    const JournalState state = readJournal(dir);
+    std::size_t done = 0;
+    std::string skipped;
+    Sculptor sculptor(recoveryStart(state, done, skipped, &gStop));
+    applyStrokes(sculptor, std::vector<Stroke>(state.script.strokes.begin() + std::ptrdiff_t(done),
+                                               state.script.strokes.end()));
+    pollInterrupt(&gStop);
+    AtomicWrite vdb = prepareLevelSet(sculptor.grid(), output);
+    std::optional<AtomicWrite> scriptFile;
+    if (!script.empty()) {
+        const std::string text =
+            formatStrokeScript(withAbsoluteStart(state.script, state.scriptDir));
+        scriptFile.emplace(script, [&](std::ostream& out) { out << text; });
+    }
+    vdb.commit();
+    if (scriptFile) scriptFile->commit();
+    std::fprintf(stderr, "%s: %s\n", dir.c_str(), describeRecovery(state, done, skipped).c_str());
+    return 0;
+}
+
 } // namespace
 
 static int run(int argc, char** argv) {
@@ -309,6 +336,15 @@ static int run(int argc, char** argv) {
                      "CAD tools)")
         ->check(CLI::IsMember({"y", "z"}));
 
+    std::string scriptOut;
+    CLI::App* recover = app.add_subcommand(
+        "recover", "Rebuild the document of a modeler session that ended in a crash");
+    recover->add_option("session", path,
+                        "A session directory, or a directory of sessions (the newest interrupted "
+                        "one is taken; default: where the modeler keeps them)");
+    recover->add_option("-o,--output", output, "Output .vdb")->required();
+    recover->add_option("--script", scriptOut, "Also write the recovered stroke script (.json)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -324,6 +360,7 @@ static int run(int argc, char** argv) {
         if (*check) return runCheck(path, asJson);
         if (*info) return runInfo(path, asJson);
         if (*apply) return runApply(applyArgs);
+        if (*recover) return runRecover(path, output, scriptOut);
         if (*create) {
             requireSphereSize(radius, voxelSize);
             requireWritable(output);

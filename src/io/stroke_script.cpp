@@ -1,6 +1,7 @@
 #include "io/stroke_script.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <initializer_list>
@@ -396,7 +397,7 @@ StrokeScript readStrokeScript(const std::string& path) {
     return parseStrokeScript(ss.str(), path);
 }
 
-std::string formatStrokeScript(const StrokeScript& s) {
+std::string formatStrokeScript(const StrokeScript& s, int indent) {
     json root;
     root["sweepers"] = s.version;
     root["grid"] = {{"voxel_size", s.grid.voxelSize}, {"half_width", s.grid.halfWidth}};
@@ -452,7 +453,14 @@ std::string formatStrokeScript(const StrokeScript& s) {
         strokes.push_back(j);
     }
     root["strokes"] = strokes;
-    return root.dump(2) + "\n";
+    return indent < 0 ? root.dump() : root.dump(indent) + "\n";
+}
+
+StrokeScript withAbsoluteStart(StrokeScript s, const std::string& scriptDir) {
+    if (s.start.kind != StartShape::Kind::Sphere && !s.start.file.empty() &&
+        s.start.file.front() != '/')
+        s.start.file = std::filesystem::absolute(scriptDir + "/" + s.start.file).string();
+    return s;
 }
 
 void writeStrokeScript(const StrokeScript& script, const std::string& path) {

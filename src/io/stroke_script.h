@@ -31,8 +31,12 @@ class ScriptError : public std::runtime_error {
 StrokeScript parseStrokeScript(const std::string& text, const std::string& name);
 // Read a file; a missing or unreadable file is a ScriptError too.
 StrokeScript readStrokeScript(const std::string& path);
-// Serialize (pretty-printed, numbers round-trip exactly).
-std::string formatStrokeScript(const StrokeScript& script);
+// Serialize (numbers round-trip exactly): pretty-printed with `indent` spaces and a final
+// line break, or on one line without a line break when indent < 0.
+std::string formatStrokeScript(const StrokeScript& script, int indent = 2);
+// The same script with its start file named absolutely (relative names are taken from
+// `scriptDir`), so that it works wherever it is saved.
+StrokeScript withAbsoluteStart(StrokeScript script, const std::string& scriptDir);
 // Write atomically: temporary file beside the target, flush, rename.
 void writeStrokeScript(const StrokeScript& script, const std::string& path);
 

@@ -144,4 +144,49 @@ echo "damaged files dropped: $(grep -c "^sweepers: .*damaged/" "$tmp/err") refus
 # --- started on a bad file: one line, non-zero exit ---------------------------------------
 if run "$tmp/fog.vdb" --replay-input "$tmp/none.json" 2>"$tmp/err"; then fail "fog volume opened"; fi
 grep -q "^sweepers: " "$tmp/err" || fail "no message for a bad start file"
+# --- kill -9 in the middle of a session, then --recover: the grid a clean run saves after
+# the same completed strokes, voxel for voxel ---------------------------------------------
+# The clean run: strokes with an undo that outlives a checkpoint, a redo; a checkpoint every
+# two strokes. It ends cleanly, so its session is removed.
+run --replay-input "$here/session_drags.json" --session-dir "$tmp/sessions" \
+    --checkpoint-every 2 --save "$tmp/clean.vdb" --save-script "$tmp/clean.json"
+[ -z "$(ls -A "$tmp/sessions")" ] || fail "a clean end left its session behind"
+strokes=$("$py" -c 'import json,sys; print(len(json.load(open(sys.argv[1]))["strokes"]))' \
+          "$tmp/clean.json")
+# The same events, then the modeler waits (an event far ahead) and is killed once the
+# journal holds every edit (6 edits, 2 undos).
+"$py" -c 'import json,sys; e=json.load(open(sys.argv[1])); e["events"].append({"frame": 10**6, "type": "scroll", "dy": 0}); json.dump(e, open(sys.argv[2], "w"))' \
+    "$here/session_drags.json" "$tmp/keepalive.json"
+"$app" --size 640x480 --replay-input "$tmp/keepalive.json" --session-dir "$tmp/sessions" \
+    --checkpoint-every 2 &
+pid=$! # the modeler itself, not a shell around it
+for _ in $(seq 600); do
+  j=$(ls "$tmp"/sessions/*/journal 2>/dev/null | head -n1 || true)
+  [ -n "$j" ] && [ "$(grep -c '"append"\|"truncate"' "$j")" = 8 ] && break
+  sleep 0.1
+done
+kill -9 $pid
+wait $pid 2>/dev/null || true
+[ "$(ls "$tmp/sessions" | wc -l)" = 1 ] || fail "the killed session is not on disk"
+cp -a "$tmp/sessions" "$tmp/sessions_copy"
+# A batch run does not offer the recovery, and leaves the interrupted session alone.
+run --replay-input "$tmp/none.json" --session-dir "$tmp/sessions" --save "$tmp/fresh.vdb"
+"$py" "$here/same_grid.py" "$tmp/default.vdb" "$tmp/fresh.vdb" >/dev/null
+[ "$(ls "$tmp/sessions" | wc -l)" = 1 ] || fail "the interrupted session was touched"
+run --recover --replay-input "$tmp/none.json" --session-dir "$tmp/sessions" \
+    --save "$tmp/recovered.vdb" --save-script "$tmp/recovered.json" 2>"$tmp/err"
+cat "$tmp/err"
+grep -q "^sweepers: recovered $strokes strokes (from the checkpoint after stroke" "$tmp/err" ||
+  fail "no recovery report"
+"$py" "$here/same_grid.py" "$tmp/clean.vdb" "$tmp/recovered.vdb"
+cmp "$tmp/clean.json" "$tmp/recovered.json" || fail "the recovered script differs"
+[ -z "$(ls -A "$tmp/sessions")" ] || fail "the recovered session was left behind"
+# The command line rebuilds the same document from the session as the crash left it.
+"$cli" recover "$tmp/sessions_copy" -o "$tmp/cli_recovered.vdb" 2>"$tmp/err"
+grep -q ": recovered $strokes strokes" "$tmp/err" || { cat "$tmp/err"; fail "sweepers-cli recover"; }
+"$py" "$here/same_grid.py" "$tmp/clean.vdb" "$tmp/cli_recovered.vdb"
+run --recover --replay-input "$tmp/none.json" --session-dir "$tmp/sessions" 2>"$tmp/err"
+grep -qx "sweepers: there is no interrupted session to recover" "$tmp/err" ||
+  fail "--recover without a session: '$(cat "$tmp/err")'"
+
 echo "all modeler checks passed"
