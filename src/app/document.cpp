@@ -126,6 +126,10 @@ SegmentReport Document::applyStroke(const Stroke& stroke) {
 }
 
 void Document::endEdit() {
+    finishEdit(/*newEdit=*/true);
+}
+
+void Document::finishEdit(bool newEdit) {
     if (!inEdit_) return;
     // A click without a drag changes nothing and is not kept.
     if (inStroke_ && current_.tools[0].path.size() >= 2) applied_.push_back(current_);
@@ -136,7 +140,8 @@ void Document::endEdit() {
     undo_.push_back({std::move(applied_), std::move(before)});
     applied_.clear();
     if (listener_) listener_->appended(*this, undo_.back().strokes);
-    redo_.clear();
+    // A new edit makes what was undone unreachable; a redo keeps the rest of it.
+    if (newEdit) redo_.clear();
     trimToBudget();
 }
 
@@ -153,6 +158,10 @@ Document::Edit Document::swapIn(Edit e) {
 
 void Document::undo() {
     endEdit();
+    if (undoNeedsReplay()) {
+        undoByReplay(replayTo(nullptr, 0));
+        return;
+    }
     if (undo_.empty()) return;
     Edit e = swapIn(std::move(undo_.back()));
     undo_.pop_back();
@@ -161,9 +170,57 @@ void Document::undo() {
     if (listener_) listener_->truncated(*this, script_.strokes.size());
 }
 
+std::size_t Document::replayTarget() const {
+    return dropped_.empty() ? script_.strokes.size() : script_.strokes.size() - dropped_.back();
+}
+
+GridPtr Document::replayTo(GridPtr grid, std::size_t done, const Progress& progress,
+                           Interrupter* interrupter) const {
+    const std::size_t target = replayTarget();
+    if (done > target) throw std::logic_error("a replay from past its target");
+    if (!grid) {
+        grid = makeStartGrid(script_, scriptDir_, 0.0, interrupter);
+        done = 0;
+    }
+    Sculptor replay(std::move(grid));
+    replay.setInterrupter(interrupter);
+    applyStrokes(replay,
+                 std::vector<Stroke>(script_.strokes.begin() + std::ptrdiff_t(done),
+                                     script_.strokes.begin() + std::ptrdiff_t(target)),
+                 progress);
+    return replay.gridPtr();
+}
+
+void Document::undoByReplay(GridPtr grid) {
+    endEdit();
+    if (!undoNeedsReplay()) throw std::logic_error("undoByReplay without an edit to undo so");
+    const std::size_t target = replayTarget();
+    Edit e;
+    e.strokes.assign(script_.strokes.begin() + std::ptrdiff_t(target), script_.strokes.end());
+    e.replay = true;
+    dropped_.pop_back();
+    markAsDocument(*grid);
+    sculptor_.replaceGrid(std::move(grid));
+    script_.strokes.resize(target);
+    redo_.push_back(std::move(e));
+    modified_ = true;
+    if (listener_) listener_->truncated(*this, script_.strokes.size());
+}
+
 void Document::redo() {
     endEdit();
     if (redo_.empty()) return;
+    if (redo_.back().replay) {
+        // Undone by replay, so no blocks were kept: the strokes are applied again, as when
+        // they were made (the same grid: the stroke step is deterministic).
+        std::vector<Stroke> strokes = std::move(redo_.back().strokes);
+        redo_.pop_back();
+        beginEdit();
+        for (const Stroke& stroke : strokes)
+            applyStroke(stroke);
+        finishEdit(/*newEdit=*/false);
+        return;
+    }
     Edit e = swapIn(std::move(redo_.back()));
     redo_.pop_back();
     script_.strokes.insert(script_.strokes.end(), e.strokes.begin(), e.strokes.end());
@@ -187,9 +244,11 @@ void Document::setUndoBudget(std::size_t bytes) {
 }
 
 void Document::trimToBudget() {
-    // The oldest strokes stop being undoable first; they stay in the script.
-    while (!undo_.empty() && undoBytes() > budget_)
+    // The oldest edits give up their blocks first; they stay undoable, by replay.
+    while (!undo_.empty() && undoBytes() > budget_) {
+        dropped_.push_back(undo_.front().strokes.size());
         undo_.pop_front();
+    }
 }
 
 void Document::saveVdb(const std::string& path) {

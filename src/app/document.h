@@ -74,14 +74,33 @@ class Document {
     SegmentReport applyStroke(const Stroke& stroke);
     void endEdit();
 
-    bool canUndo() const { return !undo_.empty(); }
+    bool canUndo() const { return !undo_.empty() || !dropped_.empty(); }
     bool canRedo() const { return !redo_.empty(); }
+    // Undoes the last edit. One whose blocks were dropped to keep within the budget is
+    // undone by replaying the history before it from the start (replayTo and undoByReplay
+    // do the same in two steps, the long one on another thread and from a checkpoint).
     void undo();
+    // Redoes the last undone edit; one undone by replay is applied again.
     void redo();
+
+    // --- undo beyond the budget -------------------------------------------------------
+    // The next undo must rebuild the grid: the edit's blocks were dropped.
+    bool undoNeedsReplay() const { return undo_.empty() && !dropped_.empty(); }
+    // How many strokes that undo leaves.
+    std::size_t replayTarget() const;
+    // The grid after the first replayTarget() strokes, made from `grid`, which holds the
+    // first `done` of them (a checkpoint; null: the start shape, done = 0). Changes nothing
+    // in the document: safe on another thread while the document is not edited.
+    GridPtr replayTo(GridPtr grid, std::size_t done, const Progress& progress = {},
+                     Interrupter* interrupter = nullptr) const;
+    // Puts in the grid replayTo made: the last edit is undone.
+    void undoByReplay(GridPtr grid);
     std::size_t undoBytes() const;
     std::size_t undoBudget() const { return budget_; }
     void setUndoBudget(std::size_t bytes);
     std::size_t undoCount() const { return undo_.size(); }
+    // Edits undone by replay only (their blocks were dropped).
+    std::size_t droppedCount() const { return dropped_.size(); }
 
     // Modified since opened or last saved (the grid or the script).
     bool modified() const { return modified_; }
@@ -99,10 +118,13 @@ class Document {
     struct Edit {
         std::vector<Stroke> strokes;
         LeafSnapshot snapshot; // undo stack: before the strokes; redo stack: after them
+        bool replay = false;   // redo stack: no snapshot, the strokes are applied again
     };
     // Runs sculpting work; a cancelled one puts back the edit in progress and rethrows.
     template <typename Work> SegmentReport cancellable(const Work& work);
     Edit swapIn(Edit e);
+    // Ends the edit in progress; a new edit (not a redo) empties the redo stack.
+    void finishEdit(bool newEdit);
     void trimToBudget();
 
     StrokeScript script_;
@@ -110,6 +132,9 @@ class Document {
     Sculptor sculptor_;
     std::deque<Edit> undo_;
     std::vector<Edit> redo_;
+    // Stroke counts of the oldest edits, whose blocks were dropped to keep within the budget
+    // (oldest first): still undoable, by replay.
+    std::vector<std::size_t> dropped_;
     std::size_t budget_ = std::size_t(512) << 20;
     bool inEdit_ = false, inStroke_ = false, modified_ = false;
     SweepStroke current_;

@@ -44,9 +44,15 @@ static int run(int argc, char** argv) {
     app.add_option("--checkpoint-every", o.checkpointStrokes,
                    "save a checkpoint of the grid every N strokes (default 20)")
         ->check(CLI::Range(1, 1000000));
+    double undoMb = 512;
+    app.add_option("--undo-budget", undoMb,
+                   "memory kept for undo, in MB (default 512); older edits are undone by "
+                   "replaying the history from a checkpoint")
+        ->check(CLI::Range(0.0, 1e7));
     app.add_option("--threads", threads, "worker threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
     CLI11_PARSE(app, argc, argv);
+    o.undoBudgetBytes = std::size_t(undoMb * 1024 * 1024);
     try {
         if (!script.empty()) {
             if (!o.open.empty()) throw std::runtime_error("give either a file or --script");

@@ -170,6 +170,11 @@ class Modeler {
             if (key == GLFW_KEY_ESCAPE) job_->stop->interrupt();
             return;
         }
+        if (ctrl && !shift && key == 'Z' && doc_->undoNeedsReplay() && !ctl_.busy() &&
+            ctl_.drag() == DragKind::None) {
+            undoByReplay();
+            return;
+        }
         if (ctl_.onKey(key, ctrl, shift) == KeyAction::Save) save(path_);
     }
 
@@ -200,6 +205,7 @@ class Modeler {
     void setDocument(std::unique_ptr<Document> doc, const Adoption& adopt = {}) {
         ctl_.setDocument(nullptr);
         doc_ = std::move(doc);
+        doc_->setUndoBudget(opt_.undoBudgetBytes);
         ctl_.setDocument(doc_.get());
         if (session_) session_->follow(*doc_, adopt);
         renderer_->update(doc_->mesher(), MeshChanges{true, {}});
@@ -207,8 +213,10 @@ class Modeler {
     }
 
     using Maker = std::function<std::unique_ptr<Document>(const Progress&, Interrupter*)>;
+    // `then`: for a job that changes the current document rather than making a new one (its
+    // maker returns null), what to do with the document when it is done.
     void startJob(const std::string& what, const Maker& make,
-                  std::shared_ptr<Adoption> adopt = nullptr) {
+                  std::shared_ptr<Adoption> adopt = nullptr, std::function<void()> then = {}) {
         auto done = std::make_shared<std::atomic<std::size_t>>(0);
         auto total = std::make_shared<std::atomic<std::size_t>>(0);
         auto stop = std::make_shared<FlagInterrupter>();
@@ -218,7 +226,28 @@ class Modeler {
         };
         job_.emplace(Job{std::async(std::launch::async,
                                     [make, progress, stop] { return make(progress, stop.get()); }),
-                         done, total, stop, what, std::move(adopt)});
+                         done, total, stop, what, std::move(adopt), std::move(then)});
+    }
+
+    // Undo beyond the budget: the grid before the edit is rebuilt off the render thread,
+    // from the session's newest checkpoint before it (or the start), then put in.
+    void undoByReplay() {
+        const std::size_t target = doc_->replayTarget();
+        std::size_t done = 0;
+        GridPtr from = session_ ? session_->checkpointAtOrBefore(target, done) : nullptr;
+        auto grid = std::make_shared<GridPtr>();
+        const Document* doc = doc_.get(); // not edited while a job runs
+        startJob(
+            "undoing by replaying " + std::to_string(target - done) + " strokes",
+            [doc, from, done, grid](const Progress& p, Interrupter* stop) {
+                *grid = doc->replayTo(from, done, p, stop);
+                return std::unique_ptr<Document>();
+            },
+            nullptr,
+            [this, grid] {
+                doc_->undoByReplay(*grid);
+                ctl_.setDocument(doc_.get()); // its volume
+            });
     }
 
     // Rebuilds the document of an interrupted session off the render thread.
@@ -252,8 +281,12 @@ class Modeler {
             fail(e.what());
             return;
         }
-        setDocument(std::move(doc), job.adopt ? *job.adopt : Adoption{});
         status_ = job.what + ": done";
+        if (job.then) {
+            job.then();
+            return;
+        }
+        setDocument(std::move(doc), job.adopt ? *job.adopt : Adoption{});
         if (job.adopt && recoveryReport_) {
             status_ = *recoveryReport_;
             std::fprintf(stderr, "sweepers: %s\n", recoveryReport_->c_str());
@@ -429,8 +462,9 @@ class Modeler {
         ImGui::Text("last segment: advect %.1f, renorm %.1f, mesh %.1f ms",
                     1e3 * (last.stats.growSeconds + last.stats.sampleSeconds),
                     1e3 * last.stats.renormalizeSeconds, 1e3 * last.meshSeconds);
-        ImGui::Text("undo: %zu strokes, %.1f of %.0f MB", info_.undoCount,
-                    double(info_.undoBytes) / (1 << 20), double(doc_->undoBudget()) / (1 << 20));
+        ImGui::Text("undo: %zu edits in %.1f of %.0f MB, %zu more by replay", info_.undoCount,
+                    double(info_.undoBytes) / (1 << 20), double(doc_->undoBudget()) / (1 << 20),
+                    doc_->droppedCount());
         // Nothing that changes the document while a drag is being sculpted.
         ImGui::BeginDisabled(ctl_.busy() || sculpting);
         if (ImGui::Button("Undo")) onKey('Z', true, false);
@@ -576,6 +610,7 @@ class Modeler {
         std::shared_ptr<FlagInterrupter> stop; // Esc or the Cancel button
         std::string what;
         std::shared_ptr<Adoption> adopt; // a recovery: what the session takes over
+        std::function<void()> then;      // see startJob
     };
     bool batch_ = false;
     SculptController ctl_;

@@ -24,6 +24,8 @@ struct ModelerOptions {
     std::string sessionDir;
     bool recover = false;
     std::size_t checkpointStrokes = 20;
+    // Memory for undo blocks; older edits are undone by replay.
+    std::size_t undoBudgetBytes = std::size_t(512) << 20;
     std::string argv0;
 };
 

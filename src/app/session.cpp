@@ -115,6 +115,7 @@ void Session::follow(Document& doc, const Adoption& adopt) {
             if (!ec) {
                 journal_.checkpointed(name, adopt.strokes);
                 checkpoints_.push_back({name, adopt.strokes});
+                publish();
             }
         }
         // The new session is on disk: the interrupted one has nothing more to give.
@@ -159,6 +160,7 @@ void Session::writeCheckpoint(const GridPtr& grid, std::size_t strokes) {
     writeLevelSet(*grid, dir_ + "/" + name); // atomic: a crash leaves no half checkpoint
     journal_.checkpointed(name, strokes);
     checkpoints_.push_back({name, strokes});
+    publish();
     {
         std::lock_guard<std::mutex> hold(mutex_);
         ++written_;
@@ -173,11 +175,41 @@ void Session::writeCheckpoint(const GridPtr& grid, std::size_t strokes) {
 void Session::dropCheckpoints(const std::function<bool(std::size_t)>& which) {
     auto gone = std::stable_partition(checkpoints_.begin(), checkpoints_.end(),
                                       [&](const Checkpoint& c) { return !which(c.strokes); });
-    for (auto c = gone; c != checkpoints_.end(); ++c) {
-        std::error_code ignored;
-        fs::remove(dir_ + "/" + c->file, ignored);
-    }
+    std::vector<std::string> files;
+    for (auto c = gone; c != checkpoints_.end(); ++c)
+        files.push_back(dir_ + "/" + c->file);
     checkpoints_.erase(gone, checkpoints_.end());
+    publish();
+    for (const std::string& f : files) {
+        std::error_code ignored;
+        fs::remove(f, ignored);
+    }
+}
+
+void Session::publish() {
+    std::lock_guard<std::mutex> hold(mutex_);
+    published_ = checkpoints_;
+}
+
+GridPtr Session::checkpointAtOrBefore(std::size_t strokes, std::size_t& done) const {
+    std::vector<Checkpoint> list;
+    {
+        std::lock_guard<std::mutex> hold(mutex_);
+        list = published_;
+    }
+    for (auto c = list.rbegin(); c != list.rend(); ++c) {
+        if (c->strokes > strokes) continue;
+        try {
+            // A file of ours, which the writer may be removing meanwhile: one that does not
+            // read is passed over for an older one.
+            GridPtr g = readLevelSetInProcess(dir_ + "/" + c->file);
+            done = c->strokes;
+            return g;
+        } catch (const std::exception&) {
+        }
+    }
+    done = 0;
+    return nullptr;
 }
 
 void Session::close() {

@@ -61,6 +61,9 @@ class Session : public HistoryListener {
     // written until the next follow(): a hole in the journal would make the rest unusable.
     std::string takeError();
     std::size_t checkpointsWritten() const;
+    // The newest checkpoint of the history's first `strokes` or fewer that can be read, and
+    // how many strokes it holds (`done`); null when there is none.
+    GridPtr checkpointAtOrBefore(std::size_t strokes, std::size_t& done) const;
 
     void appended(const Document& doc, const std::vector<Stroke>& strokes) override;
     void truncated(const Document& doc, std::size_t strokes) override;
@@ -70,6 +73,7 @@ class Session : public HistoryListener {
     void run();
     void writeCheckpoint(const GridPtr& grid, std::size_t strokes);
     void dropCheckpoints(const std::function<bool(std::size_t strokes)>& which);
+    void publish();
 
     SessionOptions opt_;
     std::string dir_;
@@ -94,6 +98,7 @@ class Session : public HistoryListener {
     bool stopping_ = false, busy_ = false;
     std::string error_;
     std::size_t written_ = 0;
+    std::vector<Checkpoint> published_; // checkpoints_, for other threads
     std::thread writer_;
 };
 

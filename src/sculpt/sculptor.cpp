@@ -7,6 +7,12 @@ namespace sweepers {
 Sculptor::Sculptor(GridPtr grid, AdvectOptions options)
     : grid_(std::move(grid)), options_(options) {}
 
+void Sculptor::replaceGrid(GridPtr grid) {
+    grid_ = std::move(grid);
+    record_ = LeafSnapshot();
+    if (meshing_) mesher_.rebuild(*grid_, options_.interrupter);
+}
+
 void Sculptor::setInterrupter(Interrupter* interrupter) {
     options_.interrupter = interrupter;
 }

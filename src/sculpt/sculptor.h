@@ -37,6 +37,9 @@ class Sculptor {
     const Grid& grid() const { return *grid_; }
     GridPtr gridPtr() const { return grid_; }
 
+    // Another grid (the same document rebuilt by replay), meshed whole when meshing.
+    void replaceGrid(GridPtr grid);
+
     // Polled during every segment (and by whole-grid meshing); null: never stops. A
     // cancelled segment throws Cancelled with the grid half-advected: restore the recording
     // (or drop the grid).

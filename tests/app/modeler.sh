@@ -153,6 +153,13 @@ run --replay-input "$here/session_drags.json" --session-dir "$tmp/sessions" \
 [ -z "$(ls -A "$tmp/sessions")" ] || fail "a clean end left its session behind"
 strokes=$("$py" -c 'import json,sys; print(len(json.load(open(sys.argv[1]))["strokes"]))' \
           "$tmp/clean.json")
+# No memory for undo: both undos rebuild the grid from a checkpoint (or the start) off the
+# render thread, the redo applies the edit again; the same grid and script.
+run --replay-input "$here/session_drags.json" --session-dir "$tmp/sessions" \
+    --checkpoint-every 2 --undo-budget 0 --save "$tmp/replayed_undo.vdb" \
+    --save-script "$tmp/replayed_undo.json"
+"$py" "$here/same_grid.py" "$tmp/clean.vdb" "$tmp/replayed_undo.vdb"
+cmp "$tmp/clean.json" "$tmp/replayed_undo.json" || fail "undo by replay: another script"
 # The same events, then the modeler waits (an event far ahead) and is killed once the
 # journal holds every edit (6 edits, 2 undos).
 "$py" -c 'import json,sys; e=json.load(open(sys.argv[1])); e["events"].append({"frame": 10**6, "type": "scroll", "dy": 0}); json.dump(e, open(sys.argv[2], "w"))' \

@@ -1,6 +1,7 @@
 // Crash-safe sessions: the journal's records, what reading makes of a journal cut short or
 // damaged, and a document rebuilt from a session that was never closed (as after a crash),
 // which must hold the very grid the document held.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -248,4 +249,86 @@ TEST(Session, AJournalThatCannotBeWrittenSaysSoOnce) {
     edit(doc, InflateStroke{{0, -1, 0}, 0.15});
     session.flush();
     EXPECT_EQ(session.takeError(), ""); // said once; nothing more is written
+}
+
+TEST(Document, UndoBeyondTheBudgetReplaysTheHistoryAndRedoAppliesTheEditAgain) {
+    Document doc(Document::sphereScript(1.0 / 24), ".");
+    std::vector<GridPtr> after{doc.grid().deepCopy()};
+    const std::vector<Stroke> strokes = {
+        dragStroke({0, 0, 1}, {0, 0, 0.3}), InflateStroke{{0, 1, 0}, 0.15},
+        SwirlStroke{{0, -1, 0}, {0.1, 0, 0}, 0.3}, dragStroke({1, 0, 0}, {0.25, 0.1, 0})};
+    for (const Stroke& s : strokes) {
+        edit(doc, s);
+        after.push_back(doc.grid().deepCopy());
+    }
+    // Only the newest edit keeps its blocks.
+    doc.setUndoBudget(doc.undoBytes() / 4);
+    ASSERT_EQ(doc.undoCount(), 1u);
+    EXPECT_FALSE(doc.undoNeedsReplay());
+    doc.undo(); // from its blocks
+    EXPECT_EQ(differingVoxels(doc.grid(), *after[3]), 0u);
+    for (std::size_t k = 3; k-- > 0;) {
+        ASSERT_TRUE(doc.undoNeedsReplay());
+        EXPECT_EQ(doc.replayTarget(), k);
+        doc.undo(); // by replay from the start
+        EXPECT_EQ(doc.script().strokes.size(), k);
+        EXPECT_EQ(differingVoxels(doc.grid(), *after[k]), 0u) << k;
+    }
+    EXPECT_FALSE(doc.canUndo());
+    // The mesh kept with the grid is the grid's.
+    SurfaceMesher fresh;
+    fresh.rebuild(doc.grid());
+    EXPECT_EQ(doc.mesher().triangleCount(), fresh.triangleCount());
+    for (std::size_t k = 1; k <= 4; ++k) {
+        ASSERT_TRUE(doc.canRedo());
+        doc.redo();
+        EXPECT_EQ(differingVoxels(doc.grid(), *after[k]), 0u) << k;
+    }
+    EXPECT_FALSE(doc.canRedo());
+    EXPECT_EQ(formatStrokeScript(doc.script()), [&] {
+        StrokeScript s = Document::sphereScript(1.0 / 24);
+        s.strokes = strokes;
+        return formatStrokeScript(s);
+    }());
+}
+
+TEST(Session, UndoBeyondTheBudgetStartsFromACheckpointAndIsJournaled) {
+    ScratchDir root;
+    SessionOptions so;
+    so.root = root.path.string();
+    so.checkpointStrokes = 2;
+    Session session(so);
+    Document doc(Document::sphereScript(1.0 / 24), ".");
+    session.follow(doc);
+    std::vector<GridPtr> after{doc.grid().deepCopy()};
+    for (int k = 0; k < 5; ++k) {
+        edit(doc, InflateStroke{{std::cos(k * 1.2), std::sin(k * 1.2), 0.2}, 0.15});
+        after.push_back(doc.grid().deepCopy());
+    }
+    session.flush();
+    doc.setUndoBudget(0); // every undo replays
+    // The edit after stroke 4: from the checkpoint after stroke 4, nothing to replay.
+    std::size_t done = 99;
+    GridPtr from = session.checkpointAtOrBefore(doc.replayTarget(), done);
+    ASSERT_TRUE(from);
+    EXPECT_EQ(done, 4u);
+    doc.undoByReplay(doc.replayTo(from, done));
+    EXPECT_EQ(differingVoxels(doc.grid(), *after[4]), 0u);
+    // After stroke 3: the checkpoint after stroke 2, and one stroke replayed.
+    session.flush();
+    from = session.checkpointAtOrBefore(doc.replayTarget(), done);
+    EXPECT_EQ(done, 2u);
+    doc.undoByReplay(doc.replayTo(from, done));
+    EXPECT_EQ(differingVoxels(doc.grid(), *after[3]), 0u);
+    // The journal knows: a crash now recovers the document as it is.
+    session.flush();
+    const JournalState st = readJournal(session.dir());
+    EXPECT_EQ(st.script.strokes.size(), 3u);
+    ScratchDir crashed; // the session as a crash would leave it (this one is still running)
+    std::filesystem::copy(session.dir(), crashed.path / "s",
+                          std::filesystem::copy_options::recursive);
+    Adoption adopt;
+    std::string report;
+    const std::unique_ptr<Document> back = recoverDocument(crashed / "s", adopt, report);
+    EXPECT_EQ(differingVoxels(back->grid(), *after[3]), 0u) << report;
 }
