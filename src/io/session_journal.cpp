@@ -145,7 +145,7 @@ JournalState readJournal(const std::string& dir) {
                 if (file.empty() || file.find('/') != std::string::npos ||
                     k > st.script.strokes.size())
                     throw std::runtime_error("a checkpoint that does not fit the history");
-                st.checkpoints.push_back({dir + "/" + file, k});
+                st.checkpoints.push_back({(fs::path(dir) / file).string(), k});
             } else {
                 throw std::runtime_error("an unknown record");
             }
@@ -168,6 +168,10 @@ GridPtr recoveryStart(const JournalState& state, std::size_t& strokes, std::stri
     std::size_t unreadable = 0;
     skipped.clear();
     for (auto c = state.checkpoints.rbegin(); c != state.checkpoints.rend(); ++c) {
+        // The modeler keeps its newest few checkpoints and removes older ones: only the
+        // newest one missing is worth a word.
+        std::error_code ec;
+        if (c != state.checkpoints.rbegin() && !fs::exists(c->file, ec)) continue;
         try {
             GridPtr g = readLevelSet(c->file);
             const double h = g->voxelSize()[0];
@@ -274,6 +278,7 @@ std::vector<std::string> interruptedSessions(const std::string& root) {
     }
     std::sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a > b; });
     std::vector<std::string> dirs;
+    dirs.reserve(found.size());
     for (auto& f : found)
         dirs.push_back(std::move(f.second));
     return dirs;

@@ -175,11 +175,11 @@ TEST(Session, ACrashedSessionRebuildsTheSameGrid) {
     adopt = {}; // lets go of the session's lock
     doc = recoverDocument(dir, adopt, report);
     EXPECT_EQ(differingVoxels(doc->grid(), *expected), 0u);
-    EXPECT_EQ(report.rfind("recovered 5 strokes (replayed from the start); a checkpoint was "
-                           "skipped: 3 checkpoints could not be read, the newest: ",
-                           0),
-              0u)
-        << report;
+    // Only the newest one missing is named (the modeler removes old ones itself).
+    const std::string newest = readJournal(dir).checkpoints.back().file;
+    EXPECT_EQ(report, "recovered 5 strokes (replayed from the start); a checkpoint was "
+                      "skipped: " +
+                          newest + ": cannot open the file");
 
     // The new session takes the old one over, and a clean close leaves nothing behind.
     {
