@@ -43,6 +43,14 @@ void spit(const std::string& path, const std::string& text) {
     std::ofstream(path, std::ios::binary | std::ios::trunc) << text;
 }
 
+// Sessions kept in `root`, a checkpoint every `every` strokes.
+SessionOptions sessionsIn(const ScratchDir& root, std::size_t every) {
+    SessionOptions so;
+    so.root = root.path.string();
+    so.checkpointStrokes = every;
+    return so;
+}
+
 // The only session directory under `root`.
 std::string onlySession(const std::string& root) {
     std::vector<std::string> dirs;
@@ -132,9 +140,7 @@ TEST(SessionJournal, ARecordCutShortOrDamagedEndsTheHistoryThere) {
 
 TEST(Session, ACrashedSessionRebuildsTheSameGrid) {
     ScratchDir root;
-    SessionOptions so;
-    so.root = root.path.string();
-    so.checkpointStrokes = 2;
+    const SessionOptions so = sessionsIn(root, 2);
     GridPtr expected;
     std::size_t strokes = 0;
     {
@@ -196,9 +202,7 @@ TEST(Session, ACrashedSessionRebuildsTheSameGrid) {
 
 TEST(Session, RecoveryStartsFromTheNewestCheckpointThatCanBeRead) {
     ScratchDir root;
-    SessionOptions so;
-    so.root = root.path.string();
-    so.checkpointStrokes = 1;
+    const SessionOptions so = sessionsIn(root, 1);
     GridPtr expected;
     {
         Session session(so);
@@ -227,9 +231,7 @@ TEST(Session, RecoveryStartsFromTheNewestCheckpointThatCanBeRead) {
 
 TEST(Session, AJournalThatCannotBeWrittenSaysSoOnce) {
     ScratchDir root;
-    SessionOptions so;
-    so.root = root.path.string();
-    so.checkpointStrokes = 1;
+    const SessionOptions so = sessionsIn(root, 1);
     Session session(so);
     Document doc(Document::sphereScript(1.0 / 16), ".");
     session.follow(doc);
@@ -294,9 +296,7 @@ TEST(Document, UndoBeyondTheBudgetReplaysTheHistoryAndRedoAppliesTheEditAgain) {
 
 TEST(Session, UndoBeyondTheBudgetStartsFromACheckpointAndIsJournaled) {
     ScratchDir root;
-    SessionOptions so;
-    so.root = root.path.string();
-    so.checkpointStrokes = 2;
+    const SessionOptions so = sessionsIn(root, 2);
     Session session(so);
     Document doc(Document::sphereScript(1.0 / 24), ".");
     session.follow(doc);
