@@ -5,6 +5,9 @@
 #include <cmath>
 #include <fstream>
 #include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include <assimp/Exporter.hpp>
 #include <assimp/Importer.hpp>
@@ -97,6 +100,64 @@ void writeMesh(const TriangleMesh& mesh, const std::string& path) {
 
 namespace {
 
+// Bytes one value of a PLY scalar type takes in a binary file (0: not a type).
+std::size_t plyTypeBytes(const std::string& type) {
+    if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+    if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+    if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" ||
+        type == "float32")
+        return 4;
+    if (type == "double" || type == "float64") return 8;
+    return 0;
+}
+
+// A PLY header announces how many elements follow, and Assimp allocates for them before it
+// reads one: a damaged count (2^31 vertices) would ask for gigabytes. Every element takes at
+// least some bytes (binary: its scalar properties and list counts; ASCII: a digit and a
+// separator per property), so counts the rest of the file cannot hold are refused first.
+void checkPlyCounts(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    in.seekg(0, std::ios::end);
+    const auto size = static_cast<unsigned long long>(std::max<std::streamoff>(0, in.tellg()));
+    in.seekg(0);
+    std::string line;
+    bool ascii = true;
+    struct Element {
+        std::string name;
+        unsigned long long count = 0, bytes = 0;
+    };
+    std::vector<Element> elements;
+    unsigned long long header = 0;
+    while (std::getline(in, line) && header < (1u << 16)) {
+        header += line.size() + 1;
+        if (!line.empty() && line.back() == '\r') line.pop_back();
+        std::istringstream words(line);
+        std::string word;
+        words >> word;
+        if (word == "end_header") break;
+        if (word == "format") {
+            words >> word;
+            ascii = word == "ascii";
+        } else if (word == "element") {
+            Element e;
+            words >> e.name >> e.count;
+            if (!words) return; // Assimp says what is wrong with the header
+            elements.push_back(e);
+        } else if (word == "property" && !elements.empty()) {
+            std::string type;
+            words >> type;
+            if (type == "list") words >> type; // the count's type: a list holds at least that
+            elements.back().bytes += ascii ? 2 : std::max<std::size_t>(1, plyTypeBytes(type));
+        }
+    }
+    const unsigned long long body = size > header ? size - header : 0;
+    for (const Element& e : elements)
+        if (e.bytes > 0 && e.count > body / e.bytes)
+            throw FileError(path + ": the header announces " + std::to_string(e.count) + " " +
+                            e.name + " elements, more than the file's " + std::to_string(body) +
+                            " bytes of data can hold (a damaged header?)");
+}
+
 // What Assimp's post-processing would crash on (it trusts face indices): checked on the
 // scene as read.
 void validateScene(const aiScene& scene, const std::string& path) {
@@ -124,6 +185,7 @@ void validateScene(const aiScene& scene, const std::string& path) {
 
 TriangleMesh readMesh(const std::string& path) {
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
+    if (extension(path) == "ply") checkPlyCounts(path);
     Assimp::Importer importer;
     const aiScene* scene = importer.ReadFile(path, 0);
     if (scene) {

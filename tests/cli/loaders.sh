@@ -50,8 +50,20 @@ ply("nan.ply", V[:3] + [("nan", "0", "0.5")], F)
 ply("enormous.ply", [(x * 1e3, y * 1e3, z * 1e3) for x, y, z in V], F)
 ply("announces.ply", V, F, count=2**31)
 ply("open.ply", V, F[:3])
+# Binary: a face count that the bytes after the header cannot hold.
+import struct
+with open("announces_binary.ply", "wb") as f:
+    f.write(b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\n"
+            b"property float y\nproperty float z\nelement face 100000000\n"
+            b"property list uchar int vertex_indices\nend_header\n")
+    for v in V:
+        f.write(struct.pack("<3f", *v))
+    for t in F:
+        f.write(struct.pack("<B3i", 3, *t))
 PY
-for f in good past_end negative infinite nan enormous announces open; do script_for $f.ply 0.05; done
+for f in good past_end negative infinite nan enormous announces announces_binary open; do
+  script_for $f.ply 0.05
+done
 "$cli" apply good.ply.json -q -o good.vdb || fail "the good tetrahedron was refused"
 refuses "face 3 refers to vertex 99, but the mesh has 4 vertices" apply past_end.ply.json -q
 refuses "face 3 refers to vertex -5, but the mesh has 4 vertices" apply negative.ply.json -q
@@ -60,7 +72,10 @@ refuses "1 vertices have coordinates that are not finite numbers" apply nan.ply.
 refuses "the start shape needs about" apply enormous.ply.json -q
 grep -q "more than the .* available; use a coarser voxel size, or --force" err ||
   fail "the memory refusal does not say what to do: $(cat err)"
-refuses "the file announces more data than memory can hold" apply announces.ply.json -q
+refuses "announces.ply: the header announces 2147483648 vertex elements, more than the file's 80 bytes of data can hold (a damaged header?)" \
+  apply announces.ply.json -q
+refuses "announces_binary.ply: the header announces 100000000 face elements, more than the file's 100 bytes of data can hold (a damaged header?)" \
+  apply announces_binary.ply.json -q
 refuses "the mesh is not closed (3 edges border a single triangle), so it has no inside" \
   apply open.ply.json -q
 
