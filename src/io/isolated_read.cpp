@@ -28,8 +28,9 @@ namespace sweepers {
 namespace {
 
 constexpr const char* kMarker = "--sweepers-read-level-set-for-parent";
-// Child exit codes besides 0 (the grid was sent) and 1 (a refusal was sent).
-constexpr int kOutOfMemory = 3, kCannotStart = 127;
+// Child exit codes besides 0 (the grid was sent). Not 1 for a refusal: a sanitizer that
+// catches the reader overrunning a buffer ends the child with 1, and that is damage.
+constexpr int kRefused = 65, kOutOfMemory = 3, kCannotStart = 127;
 // The child's descriptors for the grid and for a refusal (its stdout and stderr go nowhere).
 constexpr int kGridFd = 3, kMessageFd = 4;
 
@@ -60,7 +61,7 @@ bool serveReadIfAsked() {
         ::_exit(kOutOfMemory);
     } catch (const std::exception& e) {
         writeAll(kMessageFd, e.what());
-        ::_exit(1);
+        ::_exit(kRefused);
     }
 }
 
@@ -173,8 +174,11 @@ GridPtr readLevelSetInChild(const std::string& path, const ReadLimits& limits) {
     if (code == kOutOfMemory)
         throw FileError(path + ": the file seems damaged: reading it would take more than " +
                         formatBytes(bytes) + " of memory");
-    if (code == 1) throw FileError(message);
-    if (code != 0) throw FileError(path + ": cannot start the file reader");
+    if (code == kRefused && !message.empty()) throw FileError(message);
+    if (code == kCannotStart) throw FileError(path + ": cannot start the file reader");
+    if (code != 0)
+        throw FileError(path + ": the file is damaged: the VDB reader failed on it (exit code " +
+                        std::to_string(code) + ")");
     try {
         std::istringstream in(grid);
         openvdb::io::Stream stream(in, /*delayLoad=*/false);
