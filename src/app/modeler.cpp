@@ -253,12 +253,10 @@ class Modeler {
     // Rebuilds the document of an interrupted session off the render thread.
     void recover(const std::string& dir) {
         auto adopt = std::make_shared<Adoption>();
-        auto report = std::make_shared<std::string>();
-        recoveryReport_ = report;
         startJob(
             "recovering the session " + dir,
-            [dir, adopt, report](const Progress& p, Interrupter* stop) {
-                return recoverDocument(dir, *adopt, *report, p, stop);
+            [dir, adopt](const Progress& p, Interrupter* stop) {
+                return recoverDocument(dir, *adopt, p, stop);
             },
             adopt);
     }
@@ -287,10 +285,9 @@ class Modeler {
             return;
         }
         setDocument(std::move(doc), job.adopt ? *job.adopt : Adoption{});
-        if (job.adopt && recoveryReport_) {
-            status_ = *recoveryReport_;
-            std::fprintf(stderr, "sweepers: %s\n", recoveryReport_->c_str());
-            recoveryReport_.reset();
+        if (job.adopt) {
+            status_ = job.adopt->report;
+            std::fprintf(stderr, "sweepers: %s\n", status_.c_str());
         }
     }
 
@@ -622,7 +619,6 @@ class Modeler {
     std::unique_ptr<GlRenderer> renderer_;
     std::string offerRecovery_, offerText_; // an interrupted session the user has not
                                             // decided about, and what the offer says
-    std::shared_ptr<std::string> recoveryReport_;
     double groundY_ = -1.0;
     struct Info {
         double voxelSize = 0;

@@ -221,24 +221,17 @@ void Session::close() {
 }
 
 std::unique_ptr<Document> recoverDocument(const std::string& sessionDir, Adoption& adopt,
-                                          std::string& report, const Progress& progress,
-                                          Interrupter* interrupter) {
+                                          const Progress& progress, Interrupter* interrupter) {
     auto lock = std::make_shared<SessionLock>();
     if (!lock->acquire(sessionDir))
         throw std::runtime_error(sessionDir + ": that session is still running");
     const JournalState state = readJournal(sessionDir);
-    std::size_t done = 0;
-    std::string skipped;
-    GridPtr start = recoveryStart(state, done, skipped, interrupter);
+    RecoveryStart start = recoveryStart(state, interrupter);
     auto doc = std::make_unique<Document>(Document::resume(
-        state.script, state.scriptDir, std::move(start), done, progress, interrupter));
+        state.script, state.scriptDir, start.grid, start.strokes, progress, interrupter));
     doc->markModified(); // nothing of it is saved anywhere but in the session
-    adopt = Adoption{lock, sessionDir, "", done};
-    if (done > 0) {
-        for (const auto& c : state.checkpoints)
-            if (c.strokes == done) adopt.checkpoint = c.file;
-    }
-    report = describeRecovery(state, done, skipped);
+    adopt =
+        Adoption{lock, sessionDir, start.checkpoint, start.strokes, describeRecovery(state, start)};
     return doc;
 }
 

@@ -29,13 +29,15 @@ struct SessionOptions {
     std::size_t keepCheckpoints = 4;    // older ones are removed
 };
 
-// A checkpoint of an interrupted session that a recovered document starts from: it moves
-// into the new session, and the old session is removed once the new one is on disk.
+// What a new session takes over from the interrupted one a document was recovered from:
+// the checkpoint the document started from moves into the new session, and the old
+// session is removed once the new one is on disk.
 struct Adoption {
     std::shared_ptr<SessionLock> lock; // on oldDir, so that no other modeler recovers it too
     std::string oldDir;
     std::string checkpoint; // empty: none
     std::size_t strokes = 0;
+    std::string report; // what was recovered, in the user's words
 };
 
 class Session : public HistoryListener {
@@ -103,10 +105,9 @@ class Session : public HistoryListener {
 };
 
 // The document of an interrupted session: its last readable checkpoint and the strokes
-// after it. `report` says what was recovered, in the user's words; `adopt` is what the new
-// session takes over.
+// after it; `adopt` is what the new session takes over, and the report.
 std::unique_ptr<Document> recoverDocument(const std::string& sessionDir, Adoption& adopt,
-                                          std::string& report, const Progress& progress = {},
+                                          const Progress& progress = {},
                                           Interrupter* interrupter = nullptr);
 
 } // namespace sweepers

@@ -250,11 +250,11 @@ int runRecover(const std::string& where, const std::string& output, const std::s
     if (!script.empty()) requireWritable(script);
     const std::string dir = sessionToRecover(where.empty() ? defaultSessionRoot() : where);
     const JournalState state = readJournal(dir);
-    std::size_t done = 0;
-    std::string skipped;
-    Sculptor sculptor(recoveryStart(state, done, skipped, &gStop));
-    applyStrokes(sculptor, std::vector<Stroke>(state.script.strokes.begin() + std::ptrdiff_t(done),
-                                               state.script.strokes.end()));
+    const RecoveryStart start = recoveryStart(state, &gStop);
+    Sculptor sculptor(start.grid);
+    applyStrokes(sculptor,
+                 std::vector<Stroke>(state.script.strokes.begin() + std::ptrdiff_t(start.strokes),
+                                     state.script.strokes.end()));
     pollInterrupt(&gStop);
     AtomicWrite vdb = prepareLevelSet(sculptor.grid(), output);
     std::optional<AtomicWrite> scriptFile;
@@ -265,7 +265,7 @@ int runRecover(const std::string& where, const std::string& output, const std::s
     }
     vdb.commit();
     if (scriptFile) scriptFile->commit();
-    std::fprintf(stderr, "%s: %s\n", dir.c_str(), describeRecovery(state, done, skipped).c_str());
+    std::fprintf(stderr, "%s: %s\n", dir.c_str(), describeRecovery(state, start).c_str());
     return 0;
 }
 

@@ -163,10 +163,9 @@ JournalState readJournal(const std::string& dir) {
     return st;
 }
 
-GridPtr recoveryStart(const JournalState& state, std::size_t& strokes, std::string& skipped,
-                      Interrupter* interrupter) {
+RecoveryStart recoveryStart(const JournalState& state, Interrupter* interrupter) {
+    RecoveryStart start;
     std::size_t unreadable = 0;
-    skipped.clear();
     for (auto c = state.checkpoints.rbegin(); c != state.checkpoints.rend(); ++c) {
         // The modeler keeps its newest few checkpoints and removes older ones: only the
         // newest one missing is worth a word.
@@ -178,28 +177,29 @@ GridPtr recoveryStart(const JournalState& state, std::size_t& strokes, std::stri
             if (std::abs(h - state.script.grid.voxelSize) > 1e-9 * state.script.grid.voxelSize)
                 throw std::runtime_error(c->file + ": a checkpoint at voxel size " +
                                          formatNumber(h) + ", not the session's");
-            strokes = c->strokes;
-            return g;
+            start.grid = std::move(g);
+            start.strokes = c->strokes;
+            start.checkpoint = c->file;
+            break;
         } catch (const std::runtime_error& e) {
             // The newest failure says why; older ones are counted.
-            if (++unreadable == 1) skipped = e.what();
+            if (++unreadable == 1) start.skipped = e.what();
         }
     }
     if (unreadable > 1)
-        skipped =
-            std::to_string(unreadable) + " checkpoints could not be read, the newest: " + skipped;
-    strokes = 0;
-    return makeStartGrid(state.script, state.scriptDir, 0.0, interrupter);
+        start.skipped = std::to_string(unreadable) +
+                        " checkpoints could not be read, the newest: " + start.skipped;
+    if (!start.grid) start.grid = makeStartGrid(state.script, state.scriptDir, 0.0, interrupter);
+    return start;
 }
 
-std::string describeRecovery(const JournalState& state, std::size_t done,
-                             const std::string& skipped) {
-    const std::size_t n = state.script.strokes.size();
+std::string describeRecovery(const JournalState& state, const RecoveryStart& start) {
+    const std::size_t n = state.script.strokes.size(), done = start.strokes;
     std::string report = "recovered " + std::to_string(n) + (n == 1 ? " stroke" : " strokes") +
                          (done > 0 ? " (from the checkpoint after stroke " + std::to_string(done) +
                                          ", " + std::to_string(n - done) + " replayed)"
                                    : " (replayed from the start)");
-    if (!skipped.empty()) report += "; a checkpoint was skipped: " + skipped;
+    if (!start.skipped.empty()) report += "; a checkpoint was skipped: " + start.skipped;
     if (!state.ignored.empty()) report += "; " + state.ignored;
     return report;
 }

@@ -66,16 +66,19 @@ struct JournalState {
 // journal, or a first record that cannot be read).
 JournalState readJournal(const std::string& dir);
 
-// The grid a recovery starts from: the last checkpoint that can be read (its stroke count
-// in `strokes`), or the script's start shape (strokes = 0). A checkpoint that cannot be
-// read is skipped, with why in `skipped`.
-GridPtr recoveryStart(const JournalState& state, std::size_t& strokes, std::string& skipped,
-                      Interrupter* interrupter = nullptr);
+// The grid a recovery starts from: the newest checkpoint that can be read, or the script's
+// start shape (strokes = 0, no checkpoint).
+struct RecoveryStart {
+    GridPtr grid;
+    std::size_t strokes = 0; // of the history, already in the grid
+    std::string checkpoint;  // the file it came from, empty for the start shape
+    std::string skipped;     // why checkpoints newer than it could not be read
+};
+RecoveryStart recoveryStart(const JournalState& state, Interrupter* interrupter = nullptr);
 
 // What a recovery rebuilt, in the user's words: "recovered 12 strokes (from the checkpoint
 // after stroke 10, 2 replayed)", with what was skipped or ignored.
-std::string describeRecovery(const JournalState& state, std::size_t done,
-                             const std::string& skipped);
+std::string describeRecovery(const JournalState& state, const RecoveryStart& start);
 
 // The session a recovery reads: `path` itself when it holds a journal, else the newest
 // interrupted session under it. Throws std::runtime_error when there is none.
@@ -106,7 +109,8 @@ class SessionLock {
 bool discardSession(const std::string& dir);
 
 // Sessions under `root` whose modeler died with a journal in them (nobody holds their
-// lock), newest journal first.
+// lock), newest journal first. Dead sessions whose journal holds nothing but its opening
+// record are removed on the way: there is nothing in them to recover.
 std::vector<std::string> interruptedSessions(const std::string& root);
 
 } // namespace sweepers

@@ -167,25 +167,24 @@ TEST(Session, ACrashedSessionRebuildsTheSameGrid) {
     ASSERT_EQ(interruptedSessions(root.path.string()), std::vector<std::string>{dir});
 
     Adoption adopt;
-    std::string report;
-    std::unique_ptr<Document> doc = recoverDocument(dir, adopt, report);
+    std::unique_ptr<Document> doc = recoverDocument(dir, adopt);
     EXPECT_EQ(doc->script().strokes.size(), strokes);
     EXPECT_EQ(differingVoxels(doc->grid(), *expected), 0u);
     EXPECT_EQ(doc->grid().activeVoxelCount(), expected->activeVoxelCount());
     EXPECT_TRUE(doc->modified());
-    EXPECT_EQ(report, "recovered 5 strokes (from the checkpoint after stroke 4, 1 replayed)");
+    EXPECT_EQ(adopt.report, "recovered 5 strokes (from the checkpoint after stroke 4, 1 replayed)");
 
     // Without its checkpoints the history is replayed from the start, to the same grid.
     for (const auto& e : std::filesystem::directory_iterator(dir))
         if (e.path().extension() == ".vdb") std::filesystem::remove(e.path());
     adopt = {}; // lets go of the session's lock
-    doc = recoverDocument(dir, adopt, report);
+    doc = recoverDocument(dir, adopt);
     EXPECT_EQ(differingVoxels(doc->grid(), *expected), 0u);
     // Only the newest one missing is named (the modeler removes old ones itself).
     const std::string newest = readJournal(dir).checkpoints.back().file;
-    EXPECT_EQ(report, "recovered 5 strokes (replayed from the start); a checkpoint was "
-                      "skipped: " +
-                          newest + ": cannot open the file");
+    EXPECT_EQ(adopt.report, "recovered 5 strokes (replayed from the start); a checkpoint was "
+                            "skipped: " +
+                                newest + ": cannot open the file");
 
     // The new session takes the old one over, and a clean close leaves nothing behind.
     {
@@ -219,13 +218,12 @@ TEST(Session, RecoveryStartsFromTheNewestCheckpointThatCanBeRead) {
     ASSERT_EQ(st.checkpoints.size(), 3u);
     spit(st.checkpoints[2].file, "not a vdb"); // the newest is damaged
     Adoption adopt;
-    std::string report;
-    std::unique_ptr<Document> doc = recoverDocument(dir, adopt, report);
+    std::unique_ptr<Document> doc = recoverDocument(dir, adopt);
     EXPECT_EQ(differingVoxels(doc->grid(), *expected), 0u);
     const std::string said = "recovered 3 strokes (from the checkpoint after stroke 2, 1 "
                              "replayed); a checkpoint was skipped: " +
                              st.checkpoints[2].file + ": ";
-    EXPECT_EQ(report.rfind(said, 0), 0u) << report;
+    EXPECT_EQ(adopt.report.rfind(said, 0), 0u) << adopt.report;
     EXPECT_EQ(adopt.checkpoint, st.checkpoints[1].file);
 }
 
@@ -328,7 +326,6 @@ TEST(Session, UndoBeyondTheBudgetStartsFromACheckpointAndIsJournaled) {
     std::filesystem::copy(session.dir(), crashed.path / "s",
                           std::filesystem::copy_options::recursive);
     Adoption adopt;
-    std::string report;
-    const std::unique_ptr<Document> back = recoverDocument(crashed / "s", adopt, report);
-    EXPECT_EQ(differingVoxels(back->grid(), *after[3]), 0u) << report;
+    const std::unique_ptr<Document> back = recoverDocument(crashed / "s", adopt);
+    EXPECT_EQ(differingVoxels(back->grid(), *after[3]), 0u) << adopt.report;
 }
