@@ -118,7 +118,9 @@ for size in 1e308 0.00001; do
   rc=0
   "$cli" check size.json 2>check.err >/dev/null || rc=$?
   "$cli" apply size.json -o out.vdb 2>apply.err >/dev/null && fail "apply took voxel size $size"
-  [ "$rc" = 1 ] && cmp -s check.err apply.err ||
+  # The same refusal, but for the memory free at each moment (other work runs meanwhile).
+  masked() { sed -E 's/the [0-9.]+ [KMGT]?B available/the N available/' "$1"; }
+  [ "$rc" = 1 ] && [ "$(masked check.err)" = "$(masked apply.err)" ] ||
     fail "voxel size $size: check says '$(cat check.err)', apply says '$(cat apply.err)'"
   [ "$(wc -c <check.err)" -lt 240 ] || fail "a long refusal: $(cat check.err)"
 done
