@@ -1,6 +1,7 @@
 #include "mesh/marching_cubes.h"
 
 #include <array>
+#include <memory>
 #include <unordered_map>
 #include <utility>
 
@@ -51,6 +52,32 @@ class LeafBlock {
     std::array<float, std::size_t(kSpan) * kSpan * kSpan> values_;
 };
 
+// The vertices a leaf's cubes have made so far, by where they lie: a crossing on the edge
+// from a cube corner (leaf-local, 0 to 8 along each axis) along an axis, or the centre of
+// one of a cube's cycles (a cube has at most four: that many corners of a cube can be
+// pairwise non-adjacent). Array lookups instead of a hash map: meshing is a sixth of a
+// stroke segment.
+class LeafVertices {
+  public:
+    static constexpr int kCorners = int(LeafNode::DIM) + 1, kMaxCycles = 4;
+    LeafVertices() {
+        edges_.fill(-1);
+        centres_.fill(-1);
+    }
+    int& onEdge(const openvdb::Coord& local, int axis) {
+        return edges_[std::size_t(((local.x() * kCorners + local.y()) * kCorners + local.z()) * 3 +
+                                  axis)];
+    }
+    int& atCentre(const openvdb::Coord& local, int cycle) {
+        return centres_[std::size_t(LeafNode::coordToOffset(local)) * kMaxCycles +
+                        std::size_t(cycle)];
+    }
+
+  private:
+    std::array<int, std::size_t(kCorners) * kCorners * kCorners * 3> edges_;
+    std::array<int, LeafNode::SIZE * kMaxCycles> centres_;
+};
+
 MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
     MeshChunk chunk;
     const Grid::TreeType::LeafNodeType* leaf = grid.tree().probeConstLeaf(origin);
@@ -58,7 +85,7 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
     const LeafBlock acc(grid.getConstAccessor(), *leaf);
     const auto& xform = grid.transform();
     const double h = grid.voxelSize()[0];
-    std::unordered_map<std::uint64_t, int> vertexOf;
+    auto vertices = std::make_unique<LeafVertices>();
     auto gradient = [&](const openvdb::Coord& c) { return centralGradient(acc, c, h); };
     for (auto it = leaf->cbeginValueOn(); it; ++it) {
         const openvdb::Coord base = it.getCoord();
@@ -74,9 +101,9 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
             const mc::Edge& edge = mc::kEdges[e];
             const openvdb::Coord c0 =
                 base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
-            const std::uint64_t key = makeKey(c0, edge.axis);
-            auto [pos, inserted] = vertexOf.emplace(key, int(chunk.positions.size()));
-            if (inserted) {
+            int& id = vertices->onEdge(c0 - origin, edge.axis);
+            if (id < 0) {
+                id = int(chunk.positions.size());
                 const float a = v[edge.c0], b = v[edge.c1];
                 const float t = a / (a - b);
                 openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
@@ -89,9 +116,9 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
                 const float len = n.norm();
                 chunk.normals.push_back(len > 0 ? Eigen::Vector3f(n / len)
                                                 : Eigen::Vector3f(0, 0, 1));
-                chunk.edgeKeys.push_back(key);
+                chunk.edgeKeys.push_back(makeKey(c0, edge.axis));
             }
-            return pos->second;
+            return id;
         };
         const mc::Case& cube = mc::lookup(mask);
         int ids[3];
@@ -101,20 +128,20 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
                 if (e >= mc::kCentre) {
                     // A cycle's centre: never shared with another cube.
                     const int cycle = e - mc::kCentre;
-                    const std::uint64_t key = makeKey(base, 3) | (std::uint64_t(cycle) << 62);
-                    auto [pos, inserted] = vertexOf.emplace(key, int(chunk.positions.size()));
-                    if (inserted) {
+                    int& id = vertices->atCentre(base - origin, cycle);
+                    if (id < 0) {
                         Eigen::Vector3f p = Eigen::Vector3f::Zero(), nrm = Eigen::Vector3f::Zero();
                         for (std::uint8_t ce : cube.cycles[cycle]) {
                             const int vi = vertexOn(ce);
                             p += chunk.positions[vi];
                             nrm += chunk.normals[vi];
                         }
+                        id = int(chunk.positions.size());
                         chunk.positions.push_back(p / float(cube.cycles[cycle].size()));
                         chunk.normals.push_back(nrm.normalized());
-                        chunk.edgeKeys.push_back(key);
+                        chunk.edgeKeys.push_back(makeKey(base, 3) | (std::uint64_t(cycle) << 62));
                     }
-                    ids[k] = pos->second;
+                    ids[k] = id;
                 } else {
                     ids[k] = vertexOn(e);
                 }
