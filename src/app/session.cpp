@@ -202,7 +202,7 @@ GridPtr Session::checkpointAtOrBefore(std::size_t strokes, std::size_t& done) co
         try {
             // A file of ours, which the writer may be removing meanwhile: one that does not
             // read is passed over for an older one.
-            GridPtr g = readLevelSetInProcess(dir_ + "/" + c->file);
+            GridPtr g = readLevelSetInProcess(dir_ + "/" + c->file).grid;
             done = c->strokes;
             return g;
         } catch (const std::exception&) {

@@ -119,8 +119,19 @@ json infoJson(const LevelSetMeasures& m) {
             {"components", m.components}};
 }
 
-int runInfo(const std::string& path, bool asJson) {
-    const GridPtr grid = readLevelSet(path);
+// Reads the level set a command works on; when the file holds several and none was named,
+// says which one it took and how to take another.
+GridPtr readChosenLevelSet(const std::string& path, const std::string& gridName) {
+    const LevelSetFile file = readLevelSetFile(path, gridName);
+    if (gridName.empty() && file.levelSets > 1)
+        std::fprintf(stderr, "%s holds %zu level sets; using '%s' (choose with --grid NAME)\n",
+                     path.c_str(), file.levelSets, file.name.c_str());
+    return file.grid;
+}
+
+int runInfo(const std::string& path, const std::string& gridName, bool asJson) {
+    const LevelSetFile file = readLevelSetFile(path, gridName);
+    const GridPtr grid = file.grid;
     const LevelSetMeasures m = measureLevelSet(*grid);
     // The marching-cubes surface: its enclosed volume is exact for that surface, where
     // LevelSetMeasure's smeared integrals drift by a few tenths of a percent.
@@ -128,6 +139,8 @@ int runInfo(const std::string& path, bool asJson) {
     const double meshVolume = enclosedVolume(mesh);
     if (asJson) {
         json j = infoJson(m);
+        j["grid"] = file.name;
+        j["grids_in_file"] = file.grids;
         j["mesh_volume"] = meshVolume;
         j["mesh_triangles"] = mesh.triangles.size();
         std::cout << j.dump(2) << "\n";
@@ -138,13 +151,20 @@ int runInfo(const std::string& path, bool asJson) {
         std::snprintf(bbox, sizeof bbox, "[%g %g %g] - [%g %g %g]", m.bounds.min.x(),
                       m.bounds.min.y(), m.bounds.min.z(), m.bounds.max.x(), m.bounds.max.y(),
                       m.bounds.max.z());
-    std::printf("%s\n  voxel size %g, half-width %g voxels\n  %zu active voxels in %zu leaves, "
+    std::printf("%s, grid '%s'\n", path.c_str(), file.name.c_str());
+    if (file.grids.size() > 1) {
+        std::printf("  the file holds %zu grids:", file.grids.size());
+        for (const std::string& g : file.grids)
+            std::printf("%s %s", &g == &file.grids.front() ? "" : ",", g.c_str());
+        std::printf("\n");
+    }
+    std::printf("  voxel size %g, half-width %g voxels\n  %zu active voxels in %zu leaves, "
                 "%.1f MiB\n  bbox %s\n  volume %.6g, area %.6g\n"
                 "  Euler characteristic %d (LevelSetMeasure's curvature integral: %d), genus %d, "
                 "%zu connected component(s)\n",
-                path.c_str(), m.voxelSize, m.halfWidth, m.activeVoxels, m.leafNodes,
-                m.memoryBytes / 1048576.0, bbox, m.volume, m.area, m.eulerCharacteristic,
-                m.curvatureEuler, m.genus, m.components);
+                m.voxelSize, m.halfWidth, m.activeVoxels, m.leafNodes, m.memoryBytes / 1048576.0,
+                bbox, m.volume, m.area, m.eulerCharacteristic, m.curvatureEuler, m.genus,
+                m.components);
     std::printf("  marching-cubes surface: %zu triangles, enclosed volume %.6g\n",
                 mesh.triangles.size(), meshVolume);
     return 0;
@@ -326,10 +346,15 @@ static int run(int argc, char** argv) {
     CLI::App* info = app.add_subcommand("info", "Describe a level-set VDB file");
     info->add_option("file", path, "Level-set .vdb")->required();
     info->add_flag("--json", asJson, "Print as JSON");
+    std::string gridName;
+    info->add_option("--grid", gridName,
+                     "The level set to describe, by name (default: the first usable one)");
 
     CLI::App* mesh = app.add_subcommand("mesh", "Export the surface of a level-set VDB file");
     mesh->add_option("file", path, "Level-set .vdb")->required();
     mesh->add_option("-o,--output", output, "Output mesh (.obj, .ply, .stl)")->required();
+    mesh->add_option("--grid", gridName,
+                     "The level set to mesh, by name (default: the first usable one)");
     std::string up = "y";
     mesh->add_option("--up", up,
                      "Up axis: y (as shown) or z (Blender's PLY and STL importers, "
@@ -358,7 +383,7 @@ static int run(int argc, char** argv) {
                                                       std::size_t(threads));
     try {
         if (*check) return runCheck(path, asJson);
-        if (*info) return runInfo(path, asJson);
+        if (*info) return runInfo(path, gridName, asJson);
         if (*apply) return runApply(applyArgs);
         if (*recover) return runRecover(path, output, scriptOut);
         if (*create) {
@@ -374,7 +399,7 @@ static int run(int argc, char** argv) {
         if (*mesh) {
             requireMeshPath(output);
             requireWritable(output);
-            exportMesh(*readLevelSet(path), output, up);
+            exportMesh(*readChosenLevelSet(path, gridName), output, up);
             return 0;
         }
     } catch (const Cancelled&) {

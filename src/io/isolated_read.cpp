@@ -50,12 +50,18 @@ bool serveReadIfAsked() {
     std::vector<std::string> args;
     for (std::string arg; std::getline(cmdline, arg, '\0');)
         args.push_back(arg);
-    if (args.size() != 3 || args[1] != kMarker) return false;
+    if (args.size() != 4 || args[1] != kMarker) return false;
     try {
-        const GridPtr grid = readLevelSetInProcess(args[2]);
+        const LevelSetFile file = readLevelSetInProcess(args[2], args[3]);
         std::ostringstream out;
-        openvdb::io::Stream(out).write(openvdb::GridCPtrVec{grid});
+        openvdb::io::Stream(out).write(openvdb::GridCPtrVec{file.grid});
         writeAll(kGridFd, out.str());
+        // What else the file holds, on the message pipe: fields ended by NULs (a grid's name
+        // may hold any other character).
+        std::string about = file.name + '\0' + std::to_string(file.levelSets) + '\0';
+        for (const std::string& g : file.grids)
+            about += g + '\0';
+        writeAll(kMessageFd, about);
         ::_exit(0);
     } catch (const std::bad_alloc&) {
         ::_exit(kOutOfMemory);
@@ -87,7 +93,8 @@ std::string selfPath() {
 
 } // namespace
 
-GridPtr readLevelSetInChild(const std::string& path, const ReadLimits& limits) {
+LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gridName,
+                                 const ReadLimits& limits) {
     (void)gServed;
     initVdb();
     const std::string self = selfPath();
@@ -99,7 +106,7 @@ GridPtr readLevelSetInChild(const std::string& path, const ReadLimits& limits) {
         throw FileError("cannot start the file reader (pipe)");
     }
     const double bytes = limits.bytes > 0 ? limits.bytes : readerMemory(path);
-    std::vector<const char*> argv{self.c_str(), kMarker, path.c_str(), nullptr};
+    std::vector<const char*> argv{self.c_str(), kMarker, path.c_str(), gridName.c_str(), nullptr};
     const pid_t pid = ::fork();
     if (pid == 0) {
         // Only async-signal-safe calls until exec.
@@ -184,7 +191,18 @@ GridPtr readLevelSetInChild(const std::string& path, const ReadLimits& limits) {
         openvdb::io::Stream stream(in, /*delayLoad=*/false);
         const openvdb::GridPtrVecPtr grids = stream.getGrids();
         GridPtr g = grids && !grids->empty() ? openvdb::gridPtrCast<Grid>(grids->front()) : nullptr;
-        if (g) return g;
+        std::vector<std::string> fields;
+        for (std::size_t at = 0, end; (end = message.find('\0', at)) != std::string::npos;
+             at = end + 1)
+            fields.push_back(message.substr(at, end - at));
+        if (g && fields.size() >= 2) {
+            LevelSetFile file;
+            file.grid = g;
+            file.name = fields[0];
+            file.levelSets = std::stoul(fields[1]);
+            file.grids.assign(fields.begin() + 2, fields.end());
+            return file;
+        }
     } catch (const std::exception& e) {
     }
     throw FileError(path + ": the file reader returned no grid");

@@ -12,7 +12,7 @@
 
 #include <string>
 
-#include "levelset/vdb.h"
+#include "io/vdb_file.h"
 
 namespace sweepers {
 
@@ -22,9 +22,10 @@ struct ReadLimits {
                             // 2 GB, at most the memory available
 };
 
-// readLevelSetInProcess(path) (io/vdb_file.h) in a child process. Throws FileError with
+// readLevelSetInProcess(path, gridName) (io/vdb_file.h) in a child process. Throws FileError with
 // the child's own message when it refuses the file, or saying that the file is damaged
 // when the child crashed, ran out of time or of memory.
-GridPtr readLevelSetInChild(const std::string& path, const ReadLimits& limits = {});
+LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gridName = "",
+                                 const ReadLimits& limits = {});
 
 } // namespace sweepers

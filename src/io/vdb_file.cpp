@@ -23,14 +23,30 @@ std::size_t nonFiniteValues(const Grid& grid) {
     return bad;
 }
 
-} // namespace
-
-GridPtr readLevelSet(const std::string& path) {
-    if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
-    return readLevelSetInChild(path);
+// Why Sweepers cannot use this level set, or "" when it can.
+std::string unusable(const Grid& grid) {
+    if (!grid.hasUniformVoxels() || !grid.transform().isLinear())
+        return "has non-uniform voxels; Sweepers needs cubic voxels";
+    const double hw = halfWidthOf(grid);
+    if (!(hw >= kMinHalfWidth - 1e-6))
+        return "has a band of " + formatNumber(hw) + " voxels; Sweepers needs at least 2";
+    if (const std::size_t bad = nonFiniteValues(grid))
+        return "holds " + std::to_string(bad) + " values that are not finite numbers";
+    return "";
 }
 
-GridPtr readLevelSetInProcess(const std::string& path) {
+} // namespace
+
+LevelSetFile readLevelSetFile(const std::string& path, const std::string& gridName) {
+    if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
+    return readLevelSetInChild(path, gridName);
+}
+
+GridPtr readLevelSet(const std::string& path, const std::string& gridName) {
+    return readLevelSetFile(path, gridName).grid;
+}
+
+LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& gridName) {
     initVdb();
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
     openvdb::GridPtrVecPtr grids;
@@ -44,30 +60,41 @@ GridPtr readLevelSetInProcess(const std::string& path) {
     } catch (const std::exception& e) {
         throw FileError(path + ": not a readable VDB file (" + e.what() + ")");
     }
+    LevelSetFile out;
     std::string seen;
+    std::vector<std::string> refusals; // of the level sets passed over
     for (const openvdb::GridBase::Ptr& base : *grids) {
         const std::string what = "'" + base->getName() + "' (" + base->valueType() + ", " +
                                  openvdb::GridBase::gridClassToString(base->getGridClass()) + ")";
         seen += (seen.empty() ? "" : ", ") + what;
-        if (base->getGridClass() != openvdb::GRID_LEVEL_SET) continue;
-        GridPtr grid = openvdb::gridPtrCast<Grid>(base);
-        if (!grid) continue;
-        if (!grid->hasUniformVoxels() || !grid->transform().isLinear())
-            throw FileError(path + ": grid '" + grid->getName() +
-                            "' has non-uniform voxels; Sweepers needs cubic voxels");
-        const double hw = halfWidthOf(*grid);
-        if (!(hw >= kMinHalfWidth - 1e-6))
-            throw FileError(path + ": grid '" + grid->getName() + "' has a band of " +
-                            formatNumber(hw) + " voxels; Sweepers needs at least 2");
-        if (const std::size_t bad = nonFiniteValues(*grid))
-            throw FileError(path + ": grid '" + grid->getName() + "' holds " + std::to_string(bad) +
-                            " values that are not finite numbers");
+        out.grids.push_back(what);
+        GridPtr grid = base->getGridClass() == openvdb::GRID_LEVEL_SET
+                           ? openvdb::gridPtrCast<Grid>(base)
+                           : nullptr;
+        out.levelSets += grid != nullptr;
+        if (out.grid || (!gridName.empty() && base->getName() != gridName)) continue;
+        if (!grid) {
+            if (gridName.empty()) continue;
+            throw FileError(path + ": grid " + what + " is not a float level set");
+        }
+        if (const std::string why = unusable(*grid); !why.empty()) {
+            refusals.push_back("grid '" + grid->getName() + "' " + why);
+            continue;
+        }
+        out.name = grid->getName();
         markAsDocument(*grid);
-        return grid;
+        out.grid = grid;
     }
-    throw FileError(
-        path + ": no float level set in the file" +
-        (seen.empty() ? std::string(" (it holds no grids)") : " (it holds " + seen + ")"));
+    if (out.grid) return out;
+    if (refusals.size() == 1) throw FileError(path + ": " + refusals.front());
+    std::string why;
+    for (const std::string& r : refusals)
+        why += (why.empty() ? "" : "; ") + r;
+    if (!why.empty()) throw FileError(path + ": no level set Sweepers can use (" + why + ")");
+    const std::string holds =
+        seen.empty() ? std::string(" (it holds no grids)") : " (it holds " + seen + ")";
+    if (!gridName.empty()) throw FileError(path + ": no grid named '" + gridName + "'" + holds);
+    throw FileError(path + ": no float level set in the file" + holds);
 }
 
 namespace {

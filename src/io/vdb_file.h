@@ -1,12 +1,14 @@
 // VDB files (the README's "Files" section): one FloatGrid named "surface", class level
 // set, linear transform with the voxel size, background = half-width x voxel size,
 // negative inside, metadata creator / voxel_size / half_width. Reading accepts any float
-// level set (any name; the first level-set grid when there are several) and says why it
-// refuses anything else.
+// level set of any name: the one named, or else the first usable one in the file (a level
+// set Sweepers cannot use does not hide a good one after it), and says why it refuses
+// anything else.
 #pragma once
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "io/atomic_file.h"
 #include "levelset/vdb.h"
@@ -18,11 +20,21 @@ class FileError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// Reads the level set in a child process (io/isolated_read.h): a damaged file cannot crash
-// or hang the caller. Throws FileError saying what is wrong.
-GridPtr readLevelSet(const std::string& path);
+// A level set read from a file, and what else the file holds.
+struct LevelSetFile {
+    GridPtr grid;                   // named "surface", whatever its name in the file
+    std::string name;               // its name in the file
+    std::vector<std::string> grids; // every grid of the file: 'name' (type, class)
+    std::size_t levelSets = 0;      // how many of them are float level sets
+};
+
+// Reads the level set named `gridName` (empty: the first usable one) in a child process
+// (io/isolated_read.h): a damaged file cannot crash or hang the caller. Throws FileError
+// saying what is wrong.
+LevelSetFile readLevelSetFile(const std::string& path, const std::string& gridName = "");
+GridPtr readLevelSet(const std::string& path, const std::string& gridName = "");
 // The reader itself, in this process: for files we wrote, and for that child.
-GridPtr readLevelSetInProcess(const std::string& path);
+LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& gridName = "");
 // Atomic (io/atomic_file.h): a failed write, a full disk included, keeps the old file.
 void writeLevelSet(const Grid& grid, const std::string& path);
 // The same, written and flushed but not yet in place: commit() puts it there.

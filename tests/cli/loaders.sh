@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Files we did not write cannot take sweepers-cli down: broken meshes (indices out of
 # range or negative, non-finite or enormous coordinates, a header announcing 2^31
-# vertices, an open surface), level sets with non-finite values or no surface, scripts with
+# vertices, an open surface), level sets with non-finite values or no surface, files of
+# several grids (--grid picks one; an unusable level set hides no usable one), scripts with
 # duplicate keys or impossible sizes each get one line that says what is wrong, a non-zero
 # exit and no output; then a fixed corpus of damaged VDB, PLY, OBJ, STL and JSON files must
 # each end in success or such a refusal, within a time bound, never a crash (OpenVDB's
@@ -104,6 +105,42 @@ rc=0
 "$cli" mesh empty.vdb -o empty.ply 2>err || rc=$?
 [ "$rc" = 1 ] && grep -qF "nothing to write: the surface is empty" err && [ ! -e empty.ply ] ||
   fail "mesh of an empty level set: exit $rc, $(cat err)"
+
+# --- several grids in one file: --grid picks one, a thin level set hides no good one -------
+"$cli" new -o ball.vdb --radius 0.5 --voxel-size 0.05 2>/dev/null
+"$cli" new -o big.vdb --radius 0.8 --voxel-size 0.05 2>/dev/null
+"$py" - <<'PY'
+import pyopenvdb as vdb
+ball = vdb.read("ball.vdb", "surface"); ball.name = "ball"
+big = vdb.read("big.vdb", "surface"); big.name = "big"
+thin = vdb.FloatGrid(0.05)  # a band of one voxel: not usable
+thin.name, thin.gridClass = "a_thin", vdb.GridClass.LEVEL_SET
+thin.transform = vdb.createLinearTransform(voxelSize=0.05)
+fog = vdb.FloatGrid(0.0)
+fog.name, fog.gridClass = "density", vdb.GridClass.FOG_VOLUME
+vdb.write("multi.vdb", grids=[thin, fog, ball, big])
+PY
+"$cli" info multi.vdb >info.txt || fail "info on a file of four grids"
+grep -qF "multi.vdb, grid 'ball'" info.txt || fail "info did not take the first usable level set: $(cat info.txt)"
+grep -qF "the file holds 4 grids: 'a_thin' (float, level set), 'ball' (float, level set), 'big' (float, level set), 'density' (float, fog volume)" info.txt ||
+  fail "info did not list the grids: $(cat info.txt)"
+"$cli" info multi.vdb --grid big | grep -qF "multi.vdb, grid 'big'" || fail "info --grid big"
+"$cli" info multi.vdb --grid big --json | grep -qF '"grid": "big"' || fail "info --grid big --json"
+"$cli" mesh multi.vdb -o ball.obj 2>err || fail "mesh of a file of four grids: $(cat err)"
+grep -qF "multi.vdb holds 3 level sets; using 'ball' (choose with --grid NAME)" err ||
+  fail "mesh did not say which grid it took: $(cat err)"
+"$cli" mesh multi.vdb --grid big -o big.obj 2>err && ! grep -q "level sets; using" err ||
+  fail "mesh --grid big: $(cat err)"
+"$cli" mesh big.vdb -o big_alone.obj 2>/dev/null
+cmp -s big.obj big_alone.obj || fail "mesh --grid big differs from the mesh of the same grid alone"
+for case in "a_thin|grid 'a_thin' has a band of 1 voxels; Sweepers needs at least 2" \
+  "density|grid 'density' (float, fog volume) is not a float level set" \
+  "nope|no grid named 'nope' (it holds 'a_thin' (float, level set), 'ball'"; do
+  rc=0
+  "$cli" info multi.vdb --grid "${case%%|*}" 2>err >/dev/null || rc=$?
+  [ "$rc" = 1 ] && [ "$(wc -l <err)" = 1 ] && grep -qF "${case#*|}" err ||
+    fail "info --grid ${case%%|*}: exit $rc, $(cat err)"
+done
 
 # --- scripts: duplicate keys, sizes check refuses as apply does ---------------------------
 printf '{"sweepers": 1, "grid": {"voxel_size": 0.05, "voxel_size": 0.1, "half_width": 3}, "start": {"sphere": {"center": [0, 0, 0], "radius": 1}}, "strokes": []}' >dup.json
