@@ -9,13 +9,24 @@
 
 namespace sweepers {
 
-bool nextToCrossing(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk, float v) {
-    for (int a = 0; a < 3; ++a)
+bool nextToCrossing(const LeafNode& leaf, openvdb::Index offset, const Grid::ConstAccessor& acc) {
+    const bool inside = leaf.getValue(offset) < 0.0f;
+    const openvdb::Coord local = LeafNode::offsetToLocalCoord(offset);
+    for (int a = 0; a < 3; ++a) {
+        const openvdb::Index stride = openvdb::Index(1) << (3 * (2 - a)); // offset = x*64+y*8+z
         for (int d : {-1, 1}) {
-            openvdb::Coord n = ijk;
-            n[a] += d;
-            if ((acc.getValue(n) < 0.0f) != (v < 0.0f)) return true;
+            const int c = local[a] + d;
+            float q;
+            if (c >= 0 && c < int(LeafNode::DIM)) {
+                q = leaf.getValue(d > 0 ? offset + stride : offset - stride);
+            } else {
+                openvdb::Coord n = leaf.offsetToGlobalCoord(offset);
+                n[a] += d;
+                q = acc.getValue(n);
+            }
+            if ((q < 0.0f) != inside) return true;
         }
+    }
     return false;
 }
 
@@ -38,8 +49,8 @@ BandReport checkBand(const Grid& grid) {
                     ++acc.active;
                     const float v = *it;
                     if (std::abs(v) > limit) ++acc.beyond;
+                    if (!nextToCrossing(*leaf, it.pos(), acc_)) continue;
                     const openvdb::Coord ijk = it.getCoord();
-                    if (!nextToCrossing(acc_, ijk, v)) continue;
                     ++acc.near;
                     const double len = centralGradient(acc_, ijk, h).norm();
                     if (len >= 0.9 && len <= 1.1) ++acc.unit;

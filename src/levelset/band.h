@@ -9,9 +9,10 @@
 
 namespace sweepers {
 
-// True when a face neighbour of voxel ijk (value v) lies on the other side of the surface:
-// the voxel is next to the zero crossing.
-bool nextToCrossing(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk, float v);
+// True when a face neighbour of voxel `offset` of `leaf` lies on the other side of the
+// surface: the voxel is next to the zero crossing. Neighbours inside the leaf are read from
+// its buffer, the others through `acc` (of the leaf's grid).
+bool nextToCrossing(const LeafNode& leaf, openvdb::Index offset, const Grid::ConstAccessor& acc);
 
 struct BandReport {
     std::size_t activeVoxels = 0;

@@ -17,8 +17,6 @@
 
 namespace sweepers {
 
-using LeafNode = Grid::TreeType::LeafNodeType;
-
 // The leaves of `tree` (a Grid::TreeType, const or not) overlapping `box`.
 template <typename TreeT> auto leavesIn(TreeT& tree, const openvdb::CoordBBox& box) {
     using Leaf = std::conditional_t<std::is_const_v<TreeT>, const LeafNode, LeafNode>;

@@ -11,6 +11,7 @@ namespace sweepers {
 
 using Grid = openvdb::FloatGrid;
 using GridPtr = Grid::Ptr;
+using LeafNode = Grid::TreeType::LeafNodeType;
 
 inline Eigen::Vector3d toEigen(const openvdb::Vec3d& v) {
     return {v.x(), v.y(), v.z()};

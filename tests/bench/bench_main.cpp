@@ -61,18 +61,19 @@ DistanceErrors distanceErrors(const Grid& grid, const Sdf& exact) {
     double sumNear = 0.0, sumBand = 0.0;
     std::size_t near = 0, band = 0;
     // Methods keep bands of different widths: only the nominal band (3 voxels) counts.
-    for (auto it = grid.cbeginValueOn(); it; ++it) {
-        const double d = exact(toEigen(grid.indexToWorld(it.getCoord())));
-        if (std::abs(d) > 3.0 * h) continue;
-        const double err = std::abs(*it - d) / h;
-        e.maxBand = std::max(e.maxBand, err);
-        sumBand += err * err;
-        ++band;
-        if (!nextToCrossing(acc, it.getCoord(), *it)) continue;
-        e.maxNear = std::max(e.maxNear, err);
-        sumNear += err * err;
-        ++near;
-    }
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
+        for (auto it = leaf->cbeginValueOn(); it; ++it) {
+            const double d = exact(toEigen(grid.indexToWorld(it.getCoord())));
+            if (std::abs(d) > 3.0 * h) continue;
+            const double err = std::abs(*it - d) / h;
+            e.maxBand = std::max(e.maxBand, err);
+            sumBand += err * err;
+            ++band;
+            if (!nextToCrossing(*leaf, it.pos(), acc)) continue;
+            e.maxNear = std::max(e.maxNear, err);
+            sumNear += err * err;
+            ++near;
+        }
     e.rmsNear = std::sqrt(sumNear / double(std::max<std::size_t>(near, 1)));
     e.rmsBand = std::sqrt(sumBand / double(std::max<std::size_t>(band, 1)));
     return e;

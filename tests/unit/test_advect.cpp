@@ -45,13 +45,13 @@ double interfaceRms(const Grid& g, const std::function<double(const Eigen::Vecto
     auto acc = g.getConstAccessor();
     double sum2 = 0.0;
     std::size_t n = 0;
-    for (auto it = g.cbeginValueOn(); it; ++it) {
-        const bool near = nextToCrossing(acc, it.getCoord(), *it);
-        if (!near) continue;
-        const double e = (*it - sdf(toEigen(g.indexToWorld(it.getCoord())))) / h;
-        sum2 += e * e;
-        ++n;
-    }
+    for (auto leaf = g.tree().cbeginLeaf(); leaf; ++leaf)
+        for (auto it = leaf->cbeginValueOn(); it; ++it) {
+            if (!nextToCrossing(*leaf, it.pos(), acc)) continue;
+            const double e = (*it - sdf(toEigen(g.indexToWorld(it.getCoord())))) / h;
+            sum2 += e * e;
+            ++n;
+        }
     return std::sqrt(sum2 / n);
 }
 

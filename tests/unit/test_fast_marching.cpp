@@ -24,17 +24,17 @@ Errors compare(const Grid& g, const std::function<double(const Eigen::Vector3d&)
     const double h = g.voxelSize()[0];
     auto acc = g.getConstAccessor();
     double sum2 = 0.0;
-    for (auto it = g.cbeginValueOn(); it; ++it) {
-        const double exact = sdf(toEigen(g.indexToWorld(it.getCoord())));
-        const double err = std::abs(*it - exact) / h;
-        if ((*it < 0) != (exact < 0)) ++e.signFlips;
-        e.maxBand = std::max(e.maxBand, err);
-        const bool nearCrossing = nextToCrossing(acc, it.getCoord(), *it);
-        if (!nearCrossing) continue;
-        ++e.near;
-        e.maxNear = std::max(e.maxNear, err);
-        sum2 += err * err;
-    }
+    for (auto leaf = g.tree().cbeginLeaf(); leaf; ++leaf)
+        for (auto it = leaf->cbeginValueOn(); it; ++it) {
+            const double exact = sdf(toEigen(g.indexToWorld(it.getCoord())));
+            const double err = std::abs(*it - exact) / h;
+            if ((*it < 0) != (exact < 0)) ++e.signFlips;
+            e.maxBand = std::max(e.maxBand, err);
+            if (!nextToCrossing(*leaf, it.pos(), acc)) continue;
+            ++e.near;
+            e.maxNear = std::max(e.maxNear, err);
+            sum2 += err * err;
+        }
     e.rmsNear = std::sqrt(sum2 / std::max<std::size_t>(e.near, 1));
     return e;
 }
