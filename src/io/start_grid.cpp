@@ -57,12 +57,26 @@ GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir, 
     case StartShape::Kind::Sphere:
         return makeSphere(s.center, s.radius, h, hw);
     case StartShape::Kind::Vdb: {
-        GridPtr g = readLevelSet(resolve(s.file));
-        if (voxelSize > 0 && std::abs(g->voxelSize()[0] - h) > 1e-9 * h) {
-            // Resample to the requested voxel size through a mesh of the surface is lossy;
-            // refuse instead of guessing.
-            throw ScriptError(resolve(s.file) + ": its voxel size differs from --voxel-size");
-        }
+        // A VDB start is sculpted on its own grid. Resampling it to another voxel size or
+        // band (through a mesh of the surface) would be lossy, so a script or a command line
+        // that asks for another one is refused instead of being silently ignored.
+        GridPtr g = readLevelSet(resolve(s.file), s.gridName);
+        const double fileH = g->voxelSize()[0], fileHw = halfWidthOf(*g);
+        auto refuse = [&](const std::string& what, double file, const std::string& asked,
+                          double value) {
+            throw ScriptError(resolve(s.file) + ": its " + what + " " + formatNumber(file) +
+                              " differs from " + asked + " " + formatNumber(value) +
+                              " (a VDB start keeps its own grid: give " + formatNumber(file) +
+                              " or leave the setting out)");
+        };
+        if (voxelSize > 0 && std::abs(fileH - voxelSize) > 1e-9 * voxelSize)
+            refuse("voxel size", fileH, "--voxel-size", voxelSize);
+        if (voxelSize <= 0 && script.grid.voxelSizeGiven &&
+            std::abs(fileH - script.grid.voxelSize) > 1e-9 * script.grid.voxelSize)
+            refuse("voxel size", fileH, "the script's /grid/voxel_size", script.grid.voxelSize);
+        if (script.grid.halfWidthGiven && std::abs(fileHw - script.grid.halfWidth) > 1e-3)
+            refuse("band half-width", fileHw, "the script's /grid/half_width",
+                   script.grid.halfWidth);
         return g;
     }
     case StartShape::Kind::Mesh: {

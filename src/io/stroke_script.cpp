@@ -209,8 +209,10 @@ InflateStroke readInflate(const Reader& r, const json& v, const std::string& at)
 }
 
 StartShape readStart(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"sphere", "vdb", "mesh"});
-    if (v.size() != 1) r.fail(at, "expected exactly one of sphere, vdb, mesh");
+    r.onlyKeys(v, at, {"sphere", "vdb", "mesh", "grid"});
+    if (v.size() - v.contains("grid") != 1) r.fail(at, "expected exactly one of sphere, vdb, mesh");
+    if (v.contains("grid") && !v.contains("vdb"))
+        r.fail(at + "/grid", "names a grid of a VDB start; this start is not a VDB file");
     StartShape s;
     if (auto it = v.find("sphere"); it != v.end()) {
         r.onlyKeys(*it, at + "/sphere", {"center", "radius"});
@@ -223,6 +225,10 @@ StartShape readStart(const Reader& r, const json& v, const std::string& at) {
         const std::string key = vdb ? "vdb" : "mesh";
         s.file = r.string(v[key], at + "/" + key);
         if (s.file.empty()) r.fail(at + "/" + key, "empty file name");
+        if (v.contains("grid")) {
+            s.gridName = r.string(v["grid"], at + "/grid");
+            if (s.gridName.empty()) r.fail(at + "/grid", "empty grid name");
+        }
     }
     return s;
 }
@@ -359,9 +365,11 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name)
                                 " (this build reads version 1)");
     if (auto it = root.find("grid"); it != root.end()) {
         r.onlyKeys(*it, "/grid", {"voxel_size", "half_width"});
-        if (it->contains("voxel_size"))
+        s.grid.voxelSizeGiven = it->contains("voxel_size");
+        s.grid.halfWidthGiven = it->contains("half_width");
+        if (s.grid.voxelSizeGiven)
             s.grid.voxelSize = r.positive((*it)["voxel_size"], "/grid/voxel_size");
-        if (it->contains("half_width")) {
+        if (s.grid.halfWidthGiven) {
             s.grid.halfWidth = r.number((*it)["half_width"], "/grid/half_width");
             if (s.grid.halfWidth < 1.0 || s.grid.halfWidth > 64.0)
                 r.fail("/grid/half_width", "must lie between 1 and 64 voxels");
@@ -408,6 +416,7 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
         break;
     case StartShape::Kind::Vdb:
         root["start"] = {{"vdb", s.start.file}};
+        if (!s.start.gridName.empty()) root["start"]["grid"] = s.start.gridName;
         break;
     case StartShape::Kind::Mesh:
         root["start"] = {{"mesh", s.start.file}};

@@ -26,6 +26,8 @@ namespace sweepers {
 struct GridSpec {
     double voxelSize = 0.02;
     double halfWidth = 3.0; // in voxels
+    // Whether the script gave them (a VDB start, which keeps its own grid, must then agree).
+    bool voxelSizeGiven = false, halfWidthGiven = false;
 };
 
 struct StartShape {
@@ -33,7 +35,8 @@ struct StartShape {
     Kind kind = Kind::Sphere;
     Eigen::Vector3d center = Eigen::Vector3d::Zero();
     double radius = 1.0;
-    std::string file; // as written in the script (relative to it)
+    std::string file;     // as written in the script (relative to it)
+    std::string gridName; // of a VDB start: the level set to take (empty: the first usable)
 };
 
 enum class ToolShapeKind { Ball, Ellipsoid };

@@ -141,6 +141,19 @@ for case in "a_thin|grid 'a_thin' has a band of 1 voxels; Sweepers needs at leas
   [ "$rc" = 1 ] && [ "$(wc -l <err)" = 1 ] && grep -qF "${case#*|}" err ||
     fail "info --grid ${case%%|*}: exit $rc, $(cat err)"
 done
+# A script starts from a grid of such a file by name; a VDB start keeps its own grid, so a
+# script or a command line asking for another voxel size or band is refused, not ignored.
+printf '{"sweepers": 1, "grid": {"voxel_size": 0.05}, "start": {"vdb": "multi.vdb", "grid": "big"}, "strokes": []}' >named.json
+"$cli" apply named.json -o named.vdb -q || fail "apply from a named grid of a file"
+"$cli" mesh named.vdb -o named.obj 2>/dev/null
+cmp -s named.obj big_alone.obj || fail "the start grid named 'big' is not the sphere of radius 0.8"
+printf '{"sweepers": 1, "grid": {"voxel_size": 0.02}, "start": {"vdb": "multi.vdb"}, "strokes": []}' >h.json
+printf '{"sweepers": 1, "grid": {"half_width": 4}, "start": {"vdb": "multi.vdb"}, "strokes": []}' >hw.json
+printf '{"sweepers": 1, "start": {"vdb": "multi.vdb"}, "strokes": []}' >plain.json
+refuses "multi.vdb: its voxel size 0.05 differs from the script's /grid/voxel_size 0.02 (a VDB start keeps its own grid: give 0.05 or leave the setting out)" apply h.json
+refuses "multi.vdb: its band half-width 3 differs from the script's /grid/half_width 4" apply hw.json
+refuses "multi.vdb: its voxel size 0.05 differs from --voxel-size 0.1" apply plain.json --voxel-size 0.1
+"$cli" apply plain.json -o plain.vdb -q || fail "apply from the first usable grid of a file"
 
 # --- scripts: duplicate keys, sizes check refuses as apply does ---------------------------
 printf '{"sweepers": 1, "grid": {"voxel_size": 0.05, "voxel_size": 0.1, "half_width": 3}, "start": {"sphere": {"center": [0, 0, 0], "radius": 1}}, "strokes": []}' >dup.json

@@ -88,7 +88,8 @@ TEST(StrokeScript, EveryFieldRoundTrips) {
 TEST(StrokeScript, FileStartsRoundTripAndAtomicWrite) {
     const fs::path dir = fs::temp_directory_path() / "sweepers_script_test";
     fs::create_directories(dir);
-    for (const char* start : {R"({"vdb": "shapes/bunny.vdb"})", R"({"mesh": "tool.obj"})"}) {
+    for (const char* start : {R"({"vdb": "shapes/bunny.vdb"})", R"({"mesh": "tool.obj"})",
+                              R"({"vdb": "shapes/several.vdb", "grid": "ears"})"}) {
         const std::string text =
             std::string(R"({"sweepers": 1, "start": )") + start + R"(, "strokes": []})";
         const StrokeScript s = parseStrokeScript(text, "s.json");
@@ -97,7 +98,13 @@ TEST(StrokeScript, FileStartsRoundTripAndAtomicWrite) {
         const StrokeScript back = readStrokeScript(file.string());
         EXPECT_EQ(back.start.kind, s.start.kind);
         EXPECT_EQ(back.start.file, s.start.file);
+        EXPECT_EQ(back.start.gridName, s.start.gridName);
     }
+    EXPECT_EQ(parseStrokeScript(R"({"sweepers": 1, "start": {"vdb": "a.vdb", "grid": "ears"},
+                                   "strokes": []})",
+                                "s.json")
+                  .start.gridName,
+              "ears");
     // Nothing but the target is left in the directory.
     int files = 0;
     for (const auto& e : fs::directory_iterator(dir))
@@ -157,6 +164,11 @@ TEST(StrokeScript, BadInputIsRefusedWithFileLocationAndReason) {
          "expected a number"},
         {R"({"sweepers": 1, "start": {"sphere": {"center": [0,0,0], "radius": 1}, "vdb": "a.vdb"}, "strokes": []})",
          "/start", "exactly one"},
+        {R"({"sweepers": 1, "start": {"vdb": "a.vdb", "grid": ""}, "strokes": []})", "/start/grid",
+         "empty grid name"},
+        {R"({"sweepers": 1, "start": {"mesh": "a.obj", "grid": "b"}, "strokes": []})",
+         "/start/grid", "this start is not a VDB file"},
+        {R"({"sweepers": 1, "start": {"grid": "b"}, "strokes": []})", "/start", "exactly one"},
         {R"([1, 2])", "/", "expected an object"},
     };
     for (const Bad& b : bad) {
