@@ -1,7 +1,6 @@
 #include "mesh/marching_cubes.h"
 
 #include <array>
-#include <memory>
 #include <unordered_map>
 #include <utility>
 
@@ -52,30 +51,59 @@ class LeafBlock {
     std::array<float, std::size_t(kSpan) * kSpan * kSpan> values_;
 };
 
+// Whether the vertex named `key` may be shared with a chunk of another leaf: a crossing on
+// an edge that lies on a face of the leaf `origin`'s cubes (one of the edge's coordinates
+// across it is 0 or 8 from the origin; its cubes then belong to two leaves or more).
+// Cycle centres are never shared.
+bool sharedAcrossLeaves(std::uint64_t key, const openvdb::Coord& origin) {
+    const int axis = int(key >> 60 & 3);
+    if (axis == 3) return false;
+    const std::int64_t off = 1 << 19, mask = (1 << 20) - 1;
+    const int c[3] = {int(std::int64_t(key >> 40 & mask) - off - origin.x()),
+                      int(std::int64_t(key >> 20 & mask) - off - origin.y()),
+                      int(std::int64_t(key & mask) - off - origin.z())};
+    for (int a = 0; a < 3; ++a)
+        if (a != axis && (c[a] == 0 || c[a] == int(LeafNode::DIM))) return true;
+    return false;
+}
+
 // The vertices a leaf's cubes have made so far, by where they lie: a crossing on the edge
 // from a cube corner (leaf-local, 0 to 8 along each axis) along an axis, or the centre of
 // one of a cube's cycles (a cube has at most four: that many corners of a cube can be
-// pairwise non-adjacent). Array lookups instead of a hash map: meshing is a sixth of a
-// stroke segment.
+// pairwise non-adjacent). Array lookups instead of a hash map (meshing is a sixth of a
+// stroke segment); one table per thread, emptied for each leaf by a new generation number
+// instead of being refilled.
 class LeafVertices {
   public:
     static constexpr int kCorners = int(LeafNode::DIM) + 1, kMaxCycles = 4;
-    LeafVertices() {
-        edges_.fill(-1);
-        centres_.fill(-1);
+    static constexpr std::size_t kEdges = std::size_t(kCorners) * kCorners * kCorners * 3;
+    void clear() {
+        if (++generation_ == 0) { // after 2^32 leaves: stamps could repeat
+            stamps_.fill(0);
+            generation_ = 1;
+        }
     }
     int& onEdge(const openvdb::Coord& local, int axis) {
-        return edges_[std::size_t(((local.x() * kCorners + local.y()) * kCorners + local.z()) * 3 +
-                                  axis)];
+        return slot(
+            std::size_t(((local.x() * kCorners + local.y()) * kCorners + local.z()) * 3 + axis));
     }
     int& atCentre(const openvdb::Coord& local, int cycle) {
-        return centres_[std::size_t(LeafNode::coordToOffset(local)) * kMaxCycles +
-                        std::size_t(cycle)];
+        return slot(kEdges + std::size_t(LeafNode::coordToOffset(local)) * kMaxCycles +
+                    std::size_t(cycle));
     }
 
   private:
-    std::array<int, std::size_t(kCorners) * kCorners * kCorners * 3> edges_;
-    std::array<int, LeafNode::SIZE * kMaxCycles> centres_;
+    int& slot(std::size_t k) { // -1 until set in this generation
+        if (stamps_[k] != generation_) {
+            stamps_[k] = generation_;
+            ids_[k] = -1;
+        }
+        return ids_[k];
+    }
+    static constexpr std::size_t kSlots = kEdges + LeafNode::SIZE * kMaxCycles;
+    std::array<std::uint32_t, kSlots> stamps_{};
+    std::array<int, kSlots> ids_;
+    std::uint32_t generation_ = 0;
 };
 
 MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
@@ -85,7 +113,8 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
     const LeafBlock acc(grid.getConstAccessor(), *leaf);
     const auto& xform = grid.transform();
     const double h = grid.voxelSize()[0];
-    auto vertices = std::make_unique<LeafVertices>();
+    thread_local LeafVertices vertices;
+    vertices.clear();
     auto gradient = [&](const openvdb::Coord& c) { return centralGradient(acc, c, h); };
     for (auto it = leaf->cbeginValueOn(); it; ++it) {
         const openvdb::Coord base = it.getCoord();
@@ -101,7 +130,7 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
             const mc::Edge& edge = mc::kEdges[e];
             const openvdb::Coord c0 =
                 base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
-            int& id = vertices->onEdge(c0 - origin, edge.axis);
+            int& id = vertices.onEdge(c0 - origin, edge.axis);
             if (id < 0) {
                 id = int(chunk.positions.size());
                 const float a = v[edge.c0], b = v[edge.c1];
@@ -128,7 +157,7 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
                 if (e >= mc::kCentre) {
                     // A cycle's centre: never shared with another cube.
                     const int cycle = e - mc::kCentre;
-                    int& id = vertices->atCentre(base - origin, cycle);
+                    int& id = vertices.atCentre(base - origin, cycle);
                     if (id < 0) {
                         Eigen::Vector3f p = Eigen::Vector3f::Zero(), nrm = Eigen::Vector3f::Zero();
                         for (std::uint8_t ce : cube.cycles[cycle]) {
@@ -218,16 +247,27 @@ double SurfaceMesher::enclosedVolume() const {
 
 TriangleMesh SurfaceMesher::weld() const {
     TriangleMesh mesh;
+    // Only vertices on the faces of a leaf's cubes can appear in two chunks; the others (most
+    // of them) are added without a lookup.
     std::unordered_map<std::uint64_t, int> index;
+    std::size_t vertices = 0;
+    for (const auto& [origin, chunk] : chunks_)
+        vertices += chunk.positions.size();
+    index.reserve(vertices / 2);
+    mesh.positions.reserve(vertices);
+    mesh.normals.reserve(vertices);
     for (const auto& [origin, chunk] : chunks_) {
         std::vector<int> local(chunk.positions.size());
         for (std::size_t i = 0; i < chunk.positions.size(); ++i) {
-            auto [it, inserted] = index.emplace(chunk.edgeKeys[i], int(mesh.positions.size()));
-            if (inserted) {
+            const int next = int(mesh.positions.size());
+            const std::uint64_t key = chunk.edgeKeys[i];
+            const int id =
+                sharedAcrossLeaves(key, origin) ? index.emplace(key, next).first->second : next;
+            if (id == next) {
                 mesh.positions.push_back(chunk.positions[i]);
                 mesh.normals.push_back(chunk.normals[i]);
             }
-            local[i] = it->second;
+            local[i] = id;
         }
         for (const Eigen::Vector3i& t : chunk.triangles)
             mesh.triangles.emplace_back(local[t[0]], local[t[1]], local[t[2]]);
