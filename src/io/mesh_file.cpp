@@ -45,8 +45,45 @@ void requireMeshPath(const std::string& path) {
     if (!isMeshPath(path)) throw FileError(path + ": unknown mesh format (use .obj, .ply or .stl)");
 }
 
-AtomicWrite prepareMesh(const TriangleMesh& mesh, const std::string& path) {
+namespace {
+
+// STL stores one normal per facet, which Assimp's exporter averages from the facet's vertex
+// normals (up to several degrees off on a curved surface): each facet gets vertices of its
+// own carrying its own normal instead (STL shares no vertices anyway).
+TriangleMesh withFacetNormals(const TriangleMesh& mesh) {
+    TriangleMesh out;
+    out.positions.reserve(3 * mesh.triangles.size());
+    out.normals.reserve(3 * mesh.triangles.size());
+    out.triangles.reserve(mesh.triangles.size());
+    for (const Eigen::Vector3i& t : mesh.triangles) {
+        const Eigen::Vector3d a = mesh.positions[t[0]].cast<double>(),
+                              b = mesh.positions[t[1]].cast<double>(),
+                              c = mesh.positions[t[2]].cast<double>();
+        const Eigen::Vector3d n = (b - a).cross(c - a);
+        const double len = n.norm();
+        // (A facet of zero area has no normal of its own: it keeps its vertices' average.)
+        Eigen::Vector3f normal = Eigen::Vector3f::Zero();
+        if (len > 0)
+            normal = (n / len).cast<float>();
+        else if (mesh.normals.size() == mesh.positions.size())
+            normal = (mesh.normals[t[0]] + mesh.normals[t[1]] + mesh.normals[t[2]]).normalized();
+        const int first = int(out.positions.size());
+        for (int k = 0; k < 3; ++k) {
+            out.positions.push_back(mesh.positions[t[k]]);
+            out.normals.push_back(normal);
+        }
+        out.triangles.emplace_back(first, first + 1, first + 2);
+    }
+    return out;
+}
+
+} // namespace
+
+AtomicWrite prepareMesh(const TriangleMesh& meshIn, const std::string& path) {
     requireMeshPath(path);
+    const bool stl = extension(path) == "stl";
+    const TriangleMesh facetted = stl ? withFacetNormals(meshIn) : TriangleMesh{};
+    const TriangleMesh& mesh = stl ? facetted : meshIn;
     if (mesh.triangles.empty())
         throw FileError(path + ": nothing to write: the surface is empty (the level set has no "
                                "zero crossing)");

@@ -34,6 +34,27 @@ PY
 grep -q "volume" "$tmp/log" || fail "apply printed no volume"
 grep -q "segment 4 / 4" "$tmp/log" || fail "apply showed no progress"
 [ -s "$tmp/horn.stl" ] || fail "no mesh written"
+# STL's facet normals are the facets' own (CAD tools and slicers read them), not averages
+# of the vertex normals around them.
+"$py" - "$tmp/horn.stl" <<'PY' || fail "STL facet normals"
+import math, struct, sys
+data = open(sys.argv[1], "rb").read()
+n = struct.unpack_from("<I", data, 80)[0]
+assert len(data) == 84 + 50 * n, (len(data), n)
+worst = 0.0
+for f in range(n):
+    v = struct.unpack_from("<12f", data, 84 + 50 * f)
+    nrm, a, b, c = v[0:3], v[3:6], v[6:9], v[9:12]
+    u = [b[i] - a[i] for i in range(3)]
+    w = [c[i] - a[i] for i in range(3)]
+    x = [u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]]
+    lx, ln = math.sqrt(sum(t * t for t in x)), math.sqrt(sum(t * t for t in nrm))
+    if lx == 0:
+        continue
+    cos = sum(x[i] * nrm[i] for i in range(3)) / (lx * ln)
+    worst = max(worst, math.degrees(math.acos(max(-1.0, min(1.0, cos)))))
+assert worst < 0.05, "a facet normal is %.3f degrees off its facet" % worst
+PY
 "$cli" info --json "$tmp/horn.vdb" >"$tmp/info.json"
 "$py" - "$tmp/info.json" <<'PY'
 import json, sys
