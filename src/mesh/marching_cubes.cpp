@@ -1,5 +1,6 @@
 #include "mesh/marching_cubes.h"
 
+#include <algorithm>
 #include <array>
 #include <unordered_map>
 #include <utility>
@@ -133,8 +134,13 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
             int& id = vertices.onEdge(c0 - origin, edge.axis);
             if (id < 0) {
                 id = int(chunk.positions.size());
+                // A crossing never sits on a voxel itself (a value of exactly zero there, or a
+                // division that rounds): every edge through that voxel would put its own
+                // vertex at the same point, and the triangles between them would have no
+                // area. A thousandth of a voxel along the edge keeps them apart.
+                constexpr float kOffVoxel = 1e-3f;
                 const float a = v[edge.c0], b = v[edge.c1];
-                const float t = a / (a - b);
+                const float t = std::clamp(a / (a - b), kOffVoxel, 1.0f - kOffVoxel);
                 openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
                 p[edge.axis] += t;
                 const openvdb::Vec3d w = xform.indexToWorld(p);

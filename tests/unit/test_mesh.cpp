@@ -1,5 +1,6 @@
 #include <cmath>
 #include <random>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <openvdb/tools/LevelSetMeasure.h>
@@ -58,6 +59,45 @@ TEST(MarchingCubes, RandomFieldsGiveWatertightOrientedMeshes) {
         EXPECT_TRUE(t.watertight()) << trial;
         EXPECT_TRUE(t.consistentlyOriented()) << trial;
     }
+}
+
+TEST(MarchingCubes, ExactZerosGiveNoCoincidentVerticesOrFlatTriangles) {
+    // A value of exactly zero would put the crossing of every edge through that voxel on the
+    // voxel itself: vertices at one point, triangles between them of no area.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::size_t zeros = 0;
+    for (int trial = 0; trial < 5; ++trial) {
+        GridPtr g = Grid::create(3.0f);
+        g->setTransform(documentTransform(0.1));
+        auto acc = g->getAccessor();
+        for (int x = 0; x < 12; ++x)
+            for (int y = 0; y < 12; ++y)
+                for (int z = 0; z < 12; ++z) {
+                    const bool border = x == 0 || y == 0 || z == 0 || x == 11 || y == 11 || z == 11;
+                    float v = border ? 1.0f : u(rng);
+                    if (!border && std::abs(v) < 0.15f) { // about one voxel in seven
+                        v = 0.0f;
+                        ++zeros;
+                    }
+                    acc.setValueOn(openvdb::Coord(x, y, z), v);
+                }
+        const TriangleMesh m = meshLevelSet(*g);
+        std::set<std::array<float, 3>> seen;
+        for (const Eigen::Vector3f& p : m.positions)
+            EXPECT_TRUE(seen.insert({p.x(), p.y(), p.z()}).second) << "coincident vertices";
+        std::size_t flat = 0;
+        for (const Eigen::Vector3i& t : m.triangles) {
+            const Eigen::Vector3f a = m.positions[t[0]], b = m.positions[t[1]],
+                                  c = m.positions[t[2]];
+            flat += (b - a).cross(c - a).norm() == 0.0f;
+        }
+        EXPECT_EQ(flat, 0u) << trial;
+        const MeshTopology topo = meshTopology(m);
+        EXPECT_TRUE(topo.watertight()) << trial;
+        EXPECT_TRUE(topo.consistentlyOriented()) << trial;
+    }
+    EXPECT_GT(zeros, 500u);
 }
 
 TEST(MarchingCubes, SphereAndTorusMeshes) {
