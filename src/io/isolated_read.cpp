@@ -28,6 +28,19 @@ namespace sweepers {
 namespace {
 
 constexpr const char* kMarker = "--sweepers-read-level-set-for-parent";
+// AddressSanitizer reserves terabytes of address space, so the child's memory limit cannot
+// apply there (GCC says so with __SANITIZE_ADDRESS__, clang with __has_feature).
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
 // Child exit codes besides 0 (the grid was sent). Not 1 for a refusal: a sanitizer that
 // catches the reader overrunning a buffer ends the child with 1, and that is damage.
 constexpr int kRefused = 65, kOutOfMemory = 3, kCannotStart = 127;
@@ -120,13 +133,10 @@ LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gri
         ::dup2(null, STDERR_FILENO);
         ::dup2(grid, kGridFd);
         ::dup2(message, kMessageFd);
-#if !defined(__SANITIZE_ADDRESS__)
-        // (AddressSanitizer reserves terabytes of address space: no limit there.)
-        if (bytes > 0) {
+        if (bytes > 0 && !kAddressSanitizer) {
             const rlimit as{rlim_t(bytes), rlim_t(bytes)};
             ::setrlimit(RLIMIT_AS, &as);
         }
-#endif
         ::execv(self.c_str(), const_cast<char* const*>(argv.data()));
         ::_exit(kCannotStart);
     }

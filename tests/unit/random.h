@@ -28,7 +28,10 @@ class Rng {
     Eigen::Matrix4d rigid(double maxAngle, double maxShift) {
         Eigen::Affine3d A = Eigen::Affine3d::Identity();
         A.translate(vec(-maxShift, maxShift));
-        A.rotate(Eigen::AngleAxisd(uniform(0, maxAngle), unit()));
+        // Drawn one per statement: the order in which a call's arguments are evaluated is
+        // the compiler's choice (GCC and clang choose differently).
+        const Eigen::Vector3d axis = unit();
+        A.rotate(Eigen::AngleAxisd(uniform(0, maxAngle), axis));
         return A.matrix();
     }
 

@@ -68,7 +68,8 @@ TEST(MotionLog, ExpOfLogReproducesRandomMotions) {
         // Rigid, scaled along three axes, and rotated-and-scaled motions.
         const Eigen::Matrix4d R = rng.rigid(2.5, 2.0);
         Eigen::Matrix4d S = Eigen::Matrix4d::Identity();
-        const Eigen::Matrix3d Q = Eigen::AngleAxisd(rng.uniform(0, 3), rng.unit()).matrix();
+        const Eigen::Vector3d axis = rng.unit(); // (drawn first: see Rng::rigid)
+        const Eigen::Matrix3d Q = Eigen::AngleAxisd(rng.uniform(0, 3), axis).matrix();
         S.topLeftCorner<3, 3>() =
             Q * rng.vec(-1, 1).array().exp().matrix().asDiagonal() * Q.transpose();
         S.topRightCorner<3, 1>() = rng.vec(-1, 1);
