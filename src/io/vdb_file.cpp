@@ -75,7 +75,9 @@ LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& g
         if (out.grid || (!gridName.empty() && base->getName() != gridName)) continue;
         if (!grid) {
             if (gridName.empty()) continue;
-            throw FileError(path + ": grid " + what + " is not a float level set");
+            std::string message = path;
+            message.append(": grid ").append(what).append(" is not a float level set");
+            throw FileError(message);
         }
         if (const std::string why = unusable(*grid); !why.empty()) {
             refusals.push_back("grid '" + grid->getName() + "' " + why);

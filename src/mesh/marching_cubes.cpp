@@ -85,8 +85,12 @@ class LeafVertices {
         }
     }
     int& onEdge(const openvdb::Coord& local, int axis) {
-        return slot(
-            std::size_t(((local.x() * kCorners + local.y()) * kCorners + local.z()) * 3 + axis));
+        const std::size_t k =
+            ((std::size_t(local.x()) * kCorners + std::size_t(local.y())) * kCorners +
+             std::size_t(local.z())) *
+                3 +
+            std::size_t(axis);
+        return slot(k);
     }
     int& atCentre(const openvdb::Coord& local, int cycle) {
         return slot(kEdges + std::size_t(LeafNode::coordToOffset(local)) * kMaxCycles +
@@ -101,7 +105,7 @@ class LeafVertices {
         }
         return ids_[k];
     }
-    static constexpr std::size_t kSlots = kEdges + LeafNode::SIZE * kMaxCycles;
+    static constexpr std::size_t kSlots = kEdges + std::size_t(LeafNode::SIZE) * kMaxCycles;
     std::array<std::uint32_t, kSlots> stamps_{};
     std::array<int, kSlots> ids_;
     std::uint32_t generation_ = 0;
