@@ -39,22 +39,36 @@ TEST(MarchingCubes, TableClosesEveryConfiguration) {
     EXPECT_EQ(mc::triangles(1).size(), 1u);
 }
 
+namespace {
+
+// A noise field of 12^3 voxels, positive on its border so that its surface is closed;
+// values within `zeroBelow` of 0 are made exactly 0 (counted in `zeros`).
+GridPtr noiseBox(std::mt19937& rng, float zeroBelow = 0.0f, std::size_t* zeros = nullptr) {
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    GridPtr g = Grid::create(3.0f);
+    g->setTransform(documentTransform(0.1));
+    auto acc = g->getAccessor();
+    for (int x = 0; x < 12; ++x)
+        for (int y = 0; y < 12; ++y)
+            for (int z = 0; z < 12; ++z) {
+                const bool border = x == 0 || y == 0 || z == 0 || x == 11 || y == 11 || z == 11;
+                float v = border ? 1.0f : u(rng);
+                if (!border && std::abs(v) < zeroBelow) {
+                    v = 0.0f;
+                    ++*zeros;
+                }
+                acc.setValueOn(openvdb::Coord(x, y, z), v);
+            }
+    return g;
+}
+
+} // namespace
+
 TEST(MarchingCubes, RandomFieldsGiveWatertightOrientedMeshes) {
     // Noise fields exercise every ambiguous configuration; the mesh must still close.
     std::mt19937 rng(5);
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     for (int trial = 0; trial < 5; ++trial) {
-        GridPtr g = Grid::create(3.0f);
-        g->setTransform(documentTransform(0.1));
-        auto acc = g->getAccessor();
-        for (int x = 0; x < 12; ++x)
-            for (int y = 0; y < 12; ++y)
-                for (int z = 0; z < 12; ++z) {
-                    // Positive on the border so the surface is closed.
-                    const bool border = x == 0 || y == 0 || z == 0 || x == 11 || y == 11 || z == 11;
-                    acc.setValueOn(openvdb::Coord(x, y, z), border ? 1.0f : u(rng));
-                }
-        const MeshTopology t = meshTopology(meshLevelSet(*g));
+        const MeshTopology t = meshTopology(meshLevelSet(*noiseBox(rng)));
         EXPECT_GT(t.faces, 100u);
         EXPECT_TRUE(t.watertight()) << trial;
         EXPECT_TRUE(t.consistentlyOriented()) << trial;
@@ -65,24 +79,10 @@ TEST(MarchingCubes, ExactZerosGiveNoCoincidentVerticesOrFlatTriangles) {
     // A value of exactly zero would put the crossing of every edge through that voxel on the
     // voxel itself: vertices at one point, triangles between them of no area.
     std::mt19937 rng(11);
-    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
     std::size_t zeros = 0;
     for (int trial = 0; trial < 5; ++trial) {
-        GridPtr g = Grid::create(3.0f);
-        g->setTransform(documentTransform(0.1));
-        auto acc = g->getAccessor();
-        for (int x = 0; x < 12; ++x)
-            for (int y = 0; y < 12; ++y)
-                for (int z = 0; z < 12; ++z) {
-                    const bool border = x == 0 || y == 0 || z == 0 || x == 11 || y == 11 || z == 11;
-                    float v = border ? 1.0f : u(rng);
-                    if (!border && std::abs(v) < 0.15f) { // about one voxel in seven
-                        v = 0.0f;
-                        ++zeros;
-                    }
-                    acc.setValueOn(openvdb::Coord(x, y, z), v);
-                }
-        const TriangleMesh m = meshLevelSet(*g);
+        // About one voxel in seven exactly zero.
+        const TriangleMesh m = meshLevelSet(*noiseBox(rng, 0.15f, &zeros));
         std::set<std::array<float, 3>> seen;
         for (const Eigen::Vector3f& p : m.positions)
             EXPECT_TRUE(seen.insert({p.x(), p.y(), p.z()}).second) << "coincident vertices";
