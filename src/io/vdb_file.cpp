@@ -61,12 +61,10 @@ LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& g
         throw FileError(path + ": not a readable VDB file (" + e.what() + ")");
     }
     LevelSetFile out;
-    std::string seen;
     std::vector<std::string> refusals; // of the level sets passed over
     for (const openvdb::GridBase::Ptr& base : *grids) {
         const std::string what = "'" + base->getName() + "' (" + base->valueType() + ", " +
                                  openvdb::GridBase::gridClassToString(base->getGridClass()) + ")";
-        seen += (seen.empty() ? "" : ", ") + what;
         out.grids.push_back(what);
         GridPtr grid = base->getGridClass() == openvdb::GRID_LEVEL_SET
                            ? openvdb::gridPtrCast<Grid>(base)
@@ -93,6 +91,9 @@ LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& g
     for (const std::string& r : refusals)
         why += (why.empty() ? "" : "; ") + r;
     if (!why.empty()) throw FileError(path + ": no level set Sweepers can use (" + why + ")");
+    std::string seen;
+    for (const std::string& g : out.grids)
+        seen += (seen.empty() ? "" : ", ") + g;
     const std::string holds =
         seen.empty() ? std::string(" (it holds no grids)") : " (it holds " + seen + ")";
     if (!gridName.empty()) throw FileError(path + ": no grid named '" + gridName + "'" + holds);
