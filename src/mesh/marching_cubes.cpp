@@ -15,11 +15,20 @@ namespace sweepers {
 
 namespace {
 
-// Edge name: lowest voxel (20 bits per coordinate, +-2^19 voxels) and axis.
+// Edge name: lowest voxel (20 bits per coordinate, +-2^19 voxels) and axis (3: a cycle
+// centre, its cycle in the top two bits).
+constexpr std::int64_t kKeyOffset = 1 << 19, kKeyMask = (1 << 20) - 1;
 std::uint64_t makeKey(const openvdb::Coord& c, int axis) {
-    const std::int64_t off = 1 << 19;
-    return (std::uint64_t(c.x() + off) << 40) | (std::uint64_t(c.y() + off) << 20) |
-           std::uint64_t(c.z() + off) | (std::uint64_t(axis) << 60);
+    return (std::uint64_t(c.x() + kKeyOffset) << 40) | (std::uint64_t(c.y() + kKeyOffset) << 20) |
+           std::uint64_t(c.z() + kKeyOffset) | (std::uint64_t(axis) << 60);
+}
+int keyAxis(std::uint64_t key) {
+    return int(key >> 60 & 3);
+}
+openvdb::Coord keyVoxel(std::uint64_t key) {
+    return openvdb::Coord(int(std::int64_t(key >> 40 & kKeyMask) - kKeyOffset),
+                          int(std::int64_t(key >> 20 & kKeyMask) - kKeyOffset),
+                          int(std::int64_t(key & kKeyMask) - kKeyOffset));
 }
 
 // The values meshing one leaf reads, copied once so that every read is an array lookup:
@@ -57,12 +66,9 @@ class LeafBlock {
 // across it is 0 or 8 from the origin; its cubes then belong to two leaves or more).
 // Cycle centres are never shared.
 bool sharedAcrossLeaves(std::uint64_t key, const openvdb::Coord& origin) {
-    const int axis = int(key >> 60 & 3);
+    const int axis = keyAxis(key);
     if (axis == 3) return false;
-    const std::int64_t off = 1 << 19, mask = (1 << 20) - 1;
-    const int c[3] = {int(std::int64_t(key >> 40 & mask) - off - origin.x()),
-                      int(std::int64_t(key >> 20 & mask) - off - origin.y()),
-                      int(std::int64_t(key & mask) - off - origin.z())};
+    const openvdb::Coord c = keyVoxel(key) - origin;
     for (int a = 0; a < 3; ++a)
         if (a != axis && (c[a] == 0 || c[a] == int(LeafNode::DIM))) return true;
     return false;
