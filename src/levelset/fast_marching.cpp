@@ -88,10 +88,54 @@ class Domain {
         return neighbour<A>(i, dir);
     }
 
+    // A voxel set of a leaf as eight words, one per x; bit y * 8 + z of word x is the voxel
+    // at offset x * 64 + y * 8 + z. Scans of the domain test whole words of voxels at once
+    // and only visit the few voxels a test leaves, instead of reading six neighbours of
+    // every voxel of every leaf.
+    using Bits = std::array<std::uint64_t, 8>;
+
+    // `out` gets, for each voxel of leaf l, the bit of its neighbour one step along axis A
+    // (dir = +-1) in `sets` (one Bits per leaf); `valid` gets the voxels that have such a
+    // neighbour in the domain (0 where it would lie in a leaf outside it).
+    template <int A>
+    void stepped(const std::vector<Bits>& sets, std::size_t l, int dir, Bits& out,
+                 Bits& valid) const {
+        constexpr std::uint64_t z0 = 0x0101010101010101ull, z7 = z0 << 7;
+        constexpr std::uint64_t y0 = 0xffull, y7 = y0 << 56;
+        const Bits& w = sets[l];
+        const int nl = neighbours_[l][2 * A + (dir > 0)];
+        const Bits* n = nl < 0 ? nullptr : &sets[std::size_t(nl)];
+        for (int x = 0; x < 8; ++x) {
+            if constexpr (A == 2) { // z: within rows of eight bits
+                out[x] = dir > 0 ? ((w[x] >> 1) & ~z7) | (n ? ((*n)[x] & z0) << 7 : 0)
+                                 : ((w[x] << 1) & ~z0) | (n ? ((*n)[x] & z7) >> 7 : 0);
+                valid[x] = n ? ~0ull : ~(dir > 0 ? z7 : z0);
+            } else if constexpr (A == 1) { // y: rows of a word
+                out[x] = dir > 0 ? (w[x] >> 8) | (n ? ((*n)[x] & y0) << 56 : 0)
+                                 : (w[x] << 8) | (n ? (*n)[x] >> 56 : 0);
+                valid[x] = n ? ~0ull : ~(dir > 0 ? y7 : y0);
+            } else { // x: words of a leaf
+                const int t = x + dir;
+                const bool inside = t >= 0 && t < 8;
+                out[x] = inside ? w[std::size_t(t)] : (n ? (*n)[dir > 0 ? 0 : 7] : 0);
+                valid[x] = inside || n ? ~0ull : 0;
+            }
+        }
+    }
+
   private:
     std::vector<Leaf*> leaves_;
     std::vector<std::array<int, 6>> neighbours_;
 };
+
+using Bits = Domain::Bits;
+
+// Calls visit(offset) for every voxel of a leaf whose bit is set.
+template <typename Visit> void forEachBit(const Bits& bits, const Visit& visit) {
+    for (int x = 0; x < 8; ++x)
+        for (std::uint64_t w = bits[x]; w; w &= w - 1)
+            visit(x * 64 + __builtin_ctzll(w));
+}
 
 bool negative(float v) {
     return v < 0.0f;
@@ -223,7 +267,7 @@ class Marcher {
             FmmOrder order, Interrupter* interrupter)
         : b_(grid, region, 2), n_(indexable(b_.size())), h_(float(grid.voxelSize()[0])),
           bg_(grid.background()), order_(order), interrupter_(interrupter), phi_(n_), cells_(n_),
-          thin_(n_, 0) {
+          thin_(n_, 0), neg_(b_.leafCount(), Bits{}), settled_(b_.leafCount(), Bits{}) {
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);
@@ -236,6 +280,9 @@ class Marcher {
                 const bool inRegion = (whole || region.isInside(leaf.offsetToGlobalCoord(off))) &&
                                       (!only || (mask && mask->isValueOn(off)));
                 cells_[i] = {inRegion ? kInf : std::abs(p), inRegion ? Far : Fixed, negative(p)};
+                const std::uint64_t bit = std::uint64_t(1) << (off & 63);
+                if (negative(p)) neg_[l][off >> 6] |= bit;
+                if (!inRegion) settled_[l][off >> 6] |= bit;
             }
         });
     }
@@ -258,10 +305,37 @@ class Marcher {
     }
 
   private:
-    template <typename Body> void forAll(const Body& body) const {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const auto& r) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i)
-                body(i);
+    // Runs visit(leaf) for every leaf of the domain, in parallel.
+    template <typename Visit> void forEachLeaf(const Visit& visit) const {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, b_.leafCount()), [&](const auto& r) {
+            for (std::size_t l = r.begin(); l != r.end(); ++l)
+                visit(l);
+        });
+    }
+
+    // The voxels of a leaf with a face neighbour in `other` along some axis: one of the
+    // neighbours when `both` is false, both of them along one axis when it is true.
+    // `other(A, dir, bits)` gives, per voxel, whether its neighbour one step along axis A is
+    // in the set (Domain::stepped of some set).
+    template <typename Other> static Bits nextTo(bool both, const Other& other) {
+        Bits any{};
+        forEachAxis([&](auto a) {
+            Bits lo, hi, validLo, validHi;
+            other(a, -1, lo, validLo);
+            other(a, 1, hi, validHi);
+            for (int x = 0; x < 8; ++x)
+                any[x] |= both ? (lo[x] & validLo[x]) & (hi[x] & validHi[x])
+                               : (lo[x] & validLo[x]) | (hi[x] & validHi[x]);
+        });
+        return any;
+    }
+
+    // Per voxel of leaf l: whether its neighbour along an axis is of the other sign.
+    Bits acrossSurface(std::size_t l, bool both) const {
+        return nextTo(both, [&](auto a, int dir, Bits& out, Bits& valid) {
+            b_.stepped<decltype(a)::value>(neg_, l, dir, out, valid);
+            for (int x = 0; x < 8; ++x)
+                out[x] ^= neg_[l][x];
         });
     }
 
@@ -270,18 +344,12 @@ class Marcher {
     // too (ring 2 and 3). Thin voxels are rare, so the rings are spread from lists.
     void flagThin() {
         tbb::enumerable_thread_specific<std::vector<std::size_t>> found;
-        forAll([&](std::size_t i) {
-            const bool neg = negative(phi_[i]);
-            bool thin = false;
-            forEachAxis([&](auto a) {
-                if (thin) return;
-                const std::size_t lo = b_.neighbour(i, -1, a), hi = b_.neighbour(i, 1, a);
-                thin = lo != Domain::npos && hi != Domain::npos && negative(phi_[lo]) != neg &&
-                       negative(phi_[hi]) != neg;
+        forEachLeaf([&](std::size_t l) {
+            forEachBit(acrossSurface(l, true), [&](int off) {
+                const std::size_t i = (l << 9) + std::size_t(off);
+                thin_[i] = 1;
+                found.local().push_back(i);
             });
-            if (!thin) return;
-            thin_[i] = 1;
-            found.local().push_back(i);
         });
         std::vector<std::size_t> ring;
         for (const auto& f : found)
@@ -308,8 +376,7 @@ class Marcher {
     std::size_t seed() {
         tbb::enumerable_thread_specific<std::size_t> count(0);
         const float h = h_;
-        forAll([&](std::size_t i) {
-            if (cells_[i].state == Fixed) return;
+        const auto seedOne = [&](std::size_t i) {
             const float p = phi_[i];
             double inv2 = 0.0, grad2 = 0.0;
             float nearestCrossing = kInf;
@@ -360,6 +427,18 @@ class Marcher {
             cells_[i].u = d;
             cells_[i].state = Known;
             ++count.local();
+        };
+        // Only voxels with a face neighbour across the surface can be seeds.
+        forEachLeaf([&](std::size_t l) {
+            Bits candidates = acrossSurface(l, false);
+            for (int x = 0; x < 8; ++x)
+                candidates[x] &= ~settled_[l][x];
+            forEachBit(candidates, [&](int off) {
+                const std::size_t i = (l << 9) + std::size_t(off);
+                seedOne(i);
+                if (cells_[i].state == Known)
+                    settled_[l][std::size_t(off) >> 6] |= std::uint64_t(1) << (off & 63);
+            });
         });
         return count.combine(std::plus<>());
     }
@@ -408,17 +487,28 @@ class Marcher {
         // The first trial values: every far voxel of this side next to a known or fixed one.
         // They read only known and fixed voxels, which do not change meanwhile, so they are
         // found in parallel and queued at once.
+        // Only far voxels of this side next to a known or fixed one of this side have one.
+        std::vector<Bits> sources(b_.leafCount());
+        forEachLeaf([&](std::size_t l) {
+            for (int x = 0; x < 8; ++x)
+                sources[l][x] = settled_[l][x] & (side ? neg_[l][x] : ~neg_[l][x]);
+        });
         tbb::enumerable_thread_specific<std::vector<Entry>> first;
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n_, 4096), [&](const auto& r) {
+        forEachLeaf([&](std::size_t l) {
+            Bits candidates = nextTo(false, [&](auto a, int dir, Bits& out, Bits& valid) {
+                b_.stepped<decltype(a)::value>(sources, l, dir, out, valid);
+            });
+            for (int x = 0; x < 8; ++x)
+                candidates[x] &= ~settled_[l][x] & (side ? neg_[l][x] : ~neg_[l][x]);
             auto& out = first.local();
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                if (cells_[i].state != Far || cells_[i].neg != side) continue;
+            forEachBit(candidates, [&](int off) {
+                const std::size_t i = (l << 9) + std::size_t(off);
                 const float v = upwind(i, side);
-                if (v > limit) continue;
+                if (v > limit) return;
                 cells_[i].u = v;
                 cells_[i].state = Trial;
                 out.push_back(entry(v, i));
-            }
+            });
         });
         std::vector<Entry> items;
         for (const auto& f : first)
@@ -481,6 +571,8 @@ class Marcher {
     std::vector<float> phi_;
     std::vector<Cell> cells_;
     std::vector<std::uint8_t> thin_;
+    // Per leaf: the voxels inside, and those known or fixed (after seeding).
+    std::vector<Bits> neg_, settled_;
 };
 
 FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
