@@ -112,12 +112,13 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 }
 
 // Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
-// map(x), and marks in `changed` the voxels whose value changed (where the deformation is
-// the identity, a sample at a voxel centre returns its value exactly).
+// map(x), and marks in `changed` the voxels whose value changed. When the source holds the
+// grid's own values (`sourceIsGrid`: no widened band), a voxel that the map leaves in place
+// keeps its value without interpolating: a sample at a voxel centre returns it exactly.
 template <typename Map>
 std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const SampleSource& source,
-                     const openvdb::CoordBBox& box, const Map& map, Sampling sampling,
-                     openvdb::MaskGrid& changed, Interrupter* interrupter) {
+                     bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
+                     Sampling sampling, openvdb::MaskGrid& changed, Interrupter* interrupter) {
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> marks;
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
@@ -129,13 +130,16 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
             for (auto it = leaves[l]->beginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
                 if (!box.isInside(ijk)) continue;
-                const openvdb::Vec3d p =
-                    xform.worldToIndex(toVdb(map(toEigen(xform.indexToWorld(ijk)))));
-                float v = 0.0f;
-                if (sampling == Sampling::Trilinear)
-                    v = acc.trilinear(p);
-                else
-                    v = float(sampleMonotoneCubic(acc, p));
+                const Eigen::Vector3d x = toEigen(xform.indexToWorld(ijk));
+                const Eigen::Vector3d y = map(x);
+                float v = *it;
+                if (y != x || !sourceIsGrid) {
+                    const openvdb::Vec3d p = xform.worldToIndex(toVdb(y));
+                    if (sampling == Sampling::Trilinear)
+                        v = acc.trilinear(p);
+                    else
+                        v = float(sampleMonotoneCubic(acc, p));
+                }
                 if (v != *it || !acc.isValueOn(ijk)) marks.local().push_back(ijk);
                 it.setValue(v);
                 ++n;
@@ -330,13 +334,13 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     };
     if (!options.resampleEachSubStep) {
         stats.sampledVoxels = resample(
-            grid, moving, *source(0), region,
+            grid, moving, *source(0), !widened, region,
             [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); }, options.sampling, *changed,
             options.interrupter);
     } else {
         for (int k = 0; k < seg.steps(); ++k)
             stats.sampledVoxels += resample(
-                grid, moving, *source(k), region,
+                grid, moving, *source(k), !widened || k > 0, region,
                 [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling,
                 *changed, options.interrupter);
     }
