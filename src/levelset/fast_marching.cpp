@@ -7,6 +7,7 @@
 #include <cstring>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <stdexcept>
 #include <type_traits>
 #include <unordered_map>
@@ -266,13 +267,15 @@ class Marcher {
     Marcher(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
             FmmOrder order, Interrupter* interrupter)
         : b_(grid, region, 2), n_(indexable(b_.size())), h_(float(grid.voxelSize()[0])),
-          bg_(grid.background()), order_(order), interrupter_(interrupter), phi_(n_), cells_(n_),
-          thin_(n_, 0), neg_(b_.leafCount(), Bits{}), settled_(b_.leafCount(), Bits{}) {
+          bg_(grid.background()), order_(order), interrupter_(interrupter), phi_(new float[n_]),
+          cells_(new Cell[n_]), thin_(new std::uint8_t[n_]), neg_(b_.leafCount(), Bits{}),
+          settled_(b_.leafCount(), Bits{}) {
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);
             const bool whole = region.isInside(leaf.getNodeBoundingBox());
             const auto* mask = only ? only->tree().probeConstLeaf(leaf.origin()) : nullptr;
+            std::memset(&thin_[l << 9], 0, kLeafVoxels);
             for (int off = 0; off < kLeafVoxels; ++off) {
                 const std::size_t i = (l << 9) + off;
                 const float p = leaf.getValue(off);
@@ -568,9 +571,11 @@ class Marcher {
         State state;
         bool neg; // inside
     };
-    std::vector<float> phi_;
-    std::vector<Cell> cells_;
-    std::vector<std::uint8_t> thin_;
+    // Every entry is written by the constructor's parallel loop over the leaves, so these
+    // are allocated without the serial zeroing of a std::vector (8 MB for a drag segment).
+    std::unique_ptr<float[]> phi_;
+    std::unique_ptr<Cell[]> cells_;
+    std::unique_ptr<std::uint8_t[]> thin_;
     // Per leaf: the voxels inside, and those known or fixed (after seeding).
     std::vector<Bits> neg_, settled_;
 };
