@@ -12,6 +12,8 @@
 #include <vector>
 
 #include <openvdb/tools/SignedFloodFill.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "levelset/vdb.h"
 
@@ -39,22 +41,21 @@ template <typename TreeT> auto leavesIn(TreeT& tree, const openvdb::CoordBBox& b
 inline std::size_t floodSignsIn(Grid::TreeType& tree, const openvdb::CoordBBox& box) {
     if (box.empty()) return 0;
     const openvdb::tools::SignedFloodFillOp<Grid::TreeType> fill(tree);
-    std::size_t nodes = 0;
+    // Leaves only read their own values, so they are filled in parallel; a node's tiles take
+    // their signs from its children, so nodes are filled after them, bottom up.
+    const std::vector<LeafNode*> leaves = leavesIn(tree, box);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
+        for (std::size_t l = r.begin(); l != r.end(); ++l)
+            fill(*leaves[l]);
+    });
     for (auto upper = tree.root().beginChildOn(); upper; ++upper) {
         if (!box.hasOverlap(upper->getNodeBoundingBox())) continue;
-        for (auto lower = upper->beginChildOn(); lower; ++lower) {
-            if (!box.hasOverlap(lower->getNodeBoundingBox())) continue;
-            for (auto leaf = lower->beginChildOn(); leaf; ++leaf)
-                if (box.hasOverlap(leaf->getNodeBoundingBox())) {
-                    fill(*leaf);
-                    ++nodes;
-                }
-            fill(*lower); // its tiles, from its children's signs
-        }
+        for (auto lower = upper->beginChildOn(); lower; ++lower)
+            if (box.hasOverlap(lower->getNodeBoundingBox())) fill(*lower);
         fill(*upper);
     }
     fill(tree.root()); // the root's tiles between its (few) children
-    return nodes;
+    return leaves.size();
 }
 
 // Replaces the leaves overlapping `box` that hold no active voxel by tiles of their sign.
