@@ -55,10 +55,12 @@ SegmentReport Sculptor::applySegment(const StepDeformation& deformation) {
 SegmentReport Sculptor::applyStroke(const Stroke& stroke,
                                     const std::function<void(const SegmentReport&)>& each) {
     SegmentReport last;
-    const auto parts = planStroke(*grid_, stroke);
+    auto parts = planStroke(*grid_, stroke);
     for (std::size_t k = 0; k < parts.size(); ++k) {
-        last = applySegment(*parts[k]);
+        std::shared_ptr<const StepDeformation> part = std::move(parts[k]);
+        last = applySegment(*part);
         last.segment = k;
+        last.deformation = std::move(part);
         if (each) each(last);
     }
     return last;

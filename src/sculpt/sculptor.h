@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "levelset/advect.h"
@@ -18,6 +19,9 @@ namespace sweepers {
 
 struct SegmentReport {
     std::size_t stroke = 0, segment = 0;
+    // The deformation the segment applied, as planned (applyStroke): what an exact reference
+    // of the history composes.
+    std::shared_ptr<const StepDeformation> deformation;
     AdvectStats stats;
     double seconds = 0.0;     // advection, renormalization included
     double meshSeconds = 0.0; // incremental re-meshing of the touched leaves (when meshing)

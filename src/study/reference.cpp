@@ -1,0 +1,70 @@
+#include "study/reference.h"
+
+#include <cmath>
+#include <stdexcept>
+#include <utility>
+
+#include <openvdb/tools/Interpolation.h>
+
+namespace sweepers {
+
+ExactReference::StartFunction ExactReference::sphere(const Eigen::Vector3d& center, double radius) {
+    return [center, radius](const Eigen::Vector3d& p) { return (p - center).norm() - radius; };
+}
+
+ExactReference::StartFunction ExactReference::sampled(GridPtr start) {
+    if (!start) throw std::invalid_argument("ExactReference::sampled: no start grid");
+    return [start](const Eigen::Vector3d& p) {
+        // One accessor per call keeps the function safe to call from several threads.
+        const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
+            start->getConstAccessor(), start->transform());
+        return double(sampler.wsSample(toVdb(p)));
+    };
+}
+
+ExactReference::ExactReference(StartFunction start) : start_(std::move(start)) {
+    if (!start_) throw std::invalid_argument("ExactReference: no start shape");
+}
+
+void ExactReference::append(std::shared_ptr<const StepDeformation> deformation) {
+    if (!deformation) throw std::invalid_argument("ExactReference::append: no deformation");
+    history_.push_back(std::move(deformation));
+}
+
+Eigen::Vector3d ExactReference::pullBack(const Eigen::Vector3d& x) const {
+    // The last deformation applied is undone first.
+    Eigen::Vector3d p = x;
+    for (auto it = history_.rbegin(); it != history_.rend(); ++it)
+        p = (*it)->inverseMap(p);
+    return p;
+}
+
+double ExactReference::value(const Eigen::Vector3d& x) const {
+    return start_(pullBack(x));
+}
+
+std::optional<Eigen::Vector3d> ExactReference::crossing(const Eigen::Vector3d& a,
+                                                        const Eigen::Vector3d& b,
+                                                        double tolerance) const {
+    double lo = 0.0, hi = 1.0;
+    const double va = value(a), vb = value(b);
+    if (va == 0.0) return a;
+    if (vb == 0.0) return b;
+    if ((va < 0.0) == (vb < 0.0)) return std::nullopt;
+    const bool insideAtLo = va < 0.0;
+    // Bisection: phi_ref is continuous but not a distance (a sweep can stretch it by any
+    // factor), so only the bracket, not the values, says how far the crossing is.
+    const double length = (b - a).norm();
+    while ((hi - lo) * length > tolerance && hi - lo > 1e-15) {
+        const double mid = 0.5 * (lo + hi);
+        const double v = value(a + mid * (b - a));
+        if (v == 0.0) return a + mid * (b - a);
+        if ((v < 0.0) == insideAtLo)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return a + 0.5 * (lo + hi) * (b - a);
+}
+
+} // namespace sweepers

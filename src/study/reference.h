@@ -1,0 +1,53 @@
+// The exact shape a stroke history defines, known without any grid (the idea of thesis
+// 5.4): every sub-step is given by the closed form of its inverse (5.18, 5.19), so a point x
+// lies inside the sculpted shape exactly when the start shape contains
+// D_1^-1(D_2^-1(... D_n^-1(x))), D_1 ... D_n the deformations applied, in order. The
+// reference implicit function is phi_ref(x) = phi_start(history^-1(x)): not a distance,
+// but its zero set is the true surface, which a grid result can be measured against.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "deform/step_deformation.h"
+#include "levelset/vdb.h"
+
+namespace sweepers {
+
+class ExactReference {
+  public:
+    // The start shape's implicit function, negative inside.
+    using StartFunction = std::function<double(const Eigen::Vector3d&)>;
+
+    // A sphere's signed distance: exact.
+    static StartFunction sphere(const Eigen::Vector3d& center, double radius);
+    // A start grid sampled trilinearly (a start read from a file or a mesh): exact only up to
+    // the start grid's own sampling, which a study has to say.
+    static StartFunction sampled(GridPtr start);
+
+    explicit ExactReference(StartFunction start);
+
+    // The next deformation of the history (as applied: a segment's plan is kept, not
+    // re-planned, so that strokes planned on the grid they met are taken as they were).
+    void append(std::shared_ptr<const StepDeformation> deformation);
+    std::size_t size() const { return history_.size(); }
+
+    // history^-1(x): the point of the start shape that ends at x.
+    Eigen::Vector3d pullBack(const Eigen::Vector3d& x) const;
+    // phi_ref(x): negative inside the sculpted shape.
+    double value(const Eigen::Vector3d& x) const;
+    // The point of the segment [a, b] where phi_ref changes sign, to `tolerance` (world
+    // units) along it; nullopt when phi_ref has the same sign at both ends.
+    std::optional<Eigen::Vector3d> crossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                            double tolerance) const;
+
+  private:
+    StartFunction start_;
+    std::vector<std::shared_ptr<const StepDeformation>> history_;
+};
+
+} // namespace sweepers

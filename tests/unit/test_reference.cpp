@@ -1,0 +1,126 @@
+// The exact reference of a stroke history (study/reference.h): against analytic shapes for
+// rigid motions, and against the grid the engine sculpts for a real script.
+#include <cmath>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "deform/sweep.h"
+#include "io/stroke_script.h"
+#include "levelset/create.h"
+#include "random.h"
+#include "sculpt/sculptor.h"
+#include "study/reference.h"
+#include "tools/ellipsoid.h"
+
+using namespace sweepers;
+using sweepers::test::Rng;
+
+namespace {
+
+Placement at(Eigen::Vector3d t, double degreesAboutZ = 0.0) {
+    Placement p;
+    p.t = t;
+    p.axis = Eigen::Vector3d::UnitZ();
+    p.angleDegrees = degreesAboutZ;
+    return p;
+}
+
+// A ball tool of radius 2 moves every point within it rigidly (its influence is 1 there):
+// a sphere well inside it moves as a whole.
+ExactReference rigidlyMoved(const Eigen::Vector3d& center, double radius,
+                            const std::vector<Placement>& path) {
+    const Sweep sweep{{{std::make_shared<EllipsoidShape>(2.0), 0.5, path}}};
+    ExactReference ref(ExactReference::sphere(center, radius));
+    for (std::size_t k = 0; k < sweep.segmentCount(); ++k)
+        ref.append(std::make_shared<SweepSegment>(sweep, k));
+    return ref;
+}
+
+void expectMovedSphere(const ExactReference& ref, const Eigen::Vector3d& movedCenter,
+                       double radius) {
+    Rng rng(11);
+    for (int i = 0; i < 500; ++i) {
+        const Eigen::Vector3d x = movedCenter + rng.vec(-0.8, 0.8);
+        ASSERT_NEAR(ref.value(x), (x - movedCenter).norm() - radius, 1e-9)
+            << "at " << x.transpose();
+    }
+    // The zero set, found along rays from the centre, lies at the radius.
+    for (int i = 0; i < 50; ++i) {
+        const Eigen::Vector3d d = rng.unit();
+        const auto c = ref.crossing(movedCenter, movedCenter + 0.9 * d, 1e-12);
+        ASSERT_TRUE(c.has_value());
+        EXPECT_NEAR((*c - movedCenter).norm(), radius, 1e-9);
+    }
+}
+
+TEST(ExactReference, TranslationGivesTheMovedSphere) {
+    const Eigen::Vector3d c(0.1, 0.0, 0.0);
+    const ExactReference ref =
+        rigidlyMoved(c, 0.5, {at({0, 0, 0}), at({0.2, 0.1, 0.0}), at({0.35, 0.1, -0.1})});
+    EXPECT_EQ(ref.size(), 2u);
+    expectMovedSphere(ref, c + Eigen::Vector3d(0.35, 0.1, -0.1), 0.5);
+}
+
+TEST(ExactReference, RotationGivesTheTurnedSphere) {
+    const Eigen::Vector3d c(0.3, 0.0, 0.1);
+    const ExactReference ref = rigidlyMoved(c, 0.4, {at({0, 0, 0}), at({0, 0, 0}, 40.0)});
+    const Eigen::Vector3d turned =
+        Eigen::AngleAxisd(40.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()) * c;
+    expectMovedSphere(ref, turned, 0.4);
+}
+
+TEST(ExactReference, NoCrossingBetweenPointsOfOneSide) {
+    const ExactReference ref(ExactReference::sphere(Eigen::Vector3d::Zero(), 1.0));
+    EXPECT_FALSE(ref.crossing({0.1, 0, 0}, {0.5, 0, 0}, 1e-9).has_value());
+    EXPECT_FALSE(ref.crossing({1.5, 0, 0}, {0, 2, 0}, 1e-9).has_value());
+}
+
+// The grid the engine sculpts from data/twisted_limb.json and the exact reference of the same
+// segments agree to within a voxel everywhere: every active voxel a voxel or more from the
+// grid's surface is on the reference's side, and the reference crosses within a voxel of every
+// point of the grid's surface (found along the gradient from voxels next to it).
+TEST(ExactReference, TwistedLimbAgreesWithTheGridWithinAVoxel) {
+    const StrokeScript script =
+        readStrokeScript(std::string(SWEEPERS_DATA_DIR) + "/twisted_limb.json");
+    const double h = 1.0 / 32.0;
+    Sculptor sculptor(makeSphere(script.start.center, script.start.radius, h, 3.0));
+    ExactReference ref(ExactReference::sphere(script.start.center, script.start.radius));
+    for (const SegmentReport& r : applyStrokes(sculptor, script.strokes))
+        ref.append(r.deformation);
+    ASSERT_GT(ref.size(), 2u);
+
+    const Grid& grid = sculptor.grid();
+    auto acc = grid.getConstAccessor();
+    std::size_t far = 0, farDisagree = 0, near = 0, nearMissed = 0;
+    for (auto it = grid.cbeginValueOn(); it; ++it) {
+        const openvdb::Coord ijk = it.getCoord();
+        const Eigen::Vector3d x = toEigen(grid.indexToWorld(ijk));
+        const double phi = *it;
+        if (std::abs(phi) >= h) {
+            ++far;
+            if ((ref.value(x) < 0.0) != (phi < 0.0)) ++farDisagree;
+            continue;
+        }
+        if (std::abs(phi) > 0.5 * h) continue;
+        // The grid's surface point nearest x, and the reference's crossing along the normal.
+        Eigen::Vector3d g;
+        for (int a = 0; a < 3; ++a) {
+            openvdb::Coord lo = ijk, hi = ijk;
+            lo[a] -= 1;
+            hi[a] += 1;
+            g[a] = (acc.getValue(hi) - acc.getValue(lo)) / (2.0 * h);
+        }
+        ASSERT_GT(g.norm(), 0.0);
+        const Eigen::Vector3d n = g.normalized();
+        const Eigen::Vector3d onGrid = x - phi * n;
+        ++near;
+        if (!ref.crossing(onGrid - h * n, onGrid + h * n, 1e-6 * h)) ++nearMissed;
+    }
+    EXPECT_GT(far, 10000u);
+    EXPECT_GT(near, 1000u);
+    EXPECT_EQ(farDisagree, 0u) << "of " << far << " voxels a voxel or more from the surface";
+    EXPECT_EQ(nearMissed, 0u) << "of " << near << " points of the grid's surface";
+}
+
+} // namespace
