@@ -1,11 +1,14 @@
 // sweepers-cli: the command-line front end. Every failure prints one line on stderr,
 // exits non-zero and leaves no output file behind.
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <sstream>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -18,6 +21,7 @@
 #include "io/session_journal.h"
 #include "io/start_grid.h"
 #include "io/stroke_script.h"
+#include "io/study_files.h"
 #include "io/vdb_file.h"
 #include "levelset/create.h"
 #include "levelset/measure.h"
@@ -289,6 +293,133 @@ int runRecover(const std::string& where, const std::string& output, const std::s
     return 0;
 }
 
+struct StudyArgs {
+    std::string script, dir, voxelSizes = "1/32,1/64,1/128,1/256", variants = "trilinear";
+    bool quiet = false, force = false;
+};
+
+// "1/32,1/64,0.01": voxel sizes as decimals or 1/N, coarsest first.
+std::vector<double> parseVoxelSizes(const std::string& list) {
+    std::vector<double> sizes;
+    std::stringstream in(list);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        const std::string bad =
+            "--voxel-sizes: '" + item + "' is not a voxel size (a decimal such as 0.02, or 1/N)";
+        const bool fraction = item.rfind("1/", 0) == 0;
+        const std::string digits = fraction ? item.substr(2) : item;
+        std::size_t used = 0;
+        double v = 0.0;
+        try {
+            v = std::stod(digits, &used);
+        } catch (const std::exception&) {
+            throw std::runtime_error(bad);
+        }
+        if (used != digits.size() || !std::isfinite(v)) throw std::runtime_error(bad);
+        if (v <= 0.0)
+            throw std::runtime_error("--voxel-sizes: '" + item + "' is not a positive size");
+        const double h = fraction ? 1.0 / v : v;
+        if (std::find(sizes.begin(), sizes.end(), h) != sizes.end())
+            throw std::runtime_error("--voxel-sizes: '" + item + "' is given twice");
+        sizes.push_back(h);
+    }
+    if (sizes.empty()) throw std::runtime_error("--voxel-sizes: no voxel size given");
+    std::sort(sizes.begin(), sizes.end(), std::greater<>());
+    return sizes;
+}
+
+std::vector<StudyVariant> parseVariants(const std::string& list) {
+    std::vector<StudyVariant> out;
+    std::stringstream in(list);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        const auto v = parseVariant(item);
+        if (!v)
+            throw std::runtime_error("--variants: unknown variant '" + item +
+                                     "' (trilinear, cubic, per-substep, first-order)");
+        if (std::find(out.begin(), out.end(), *v) == out.end()) out.push_back(*v);
+    }
+    if (out.empty()) throw std::runtime_error("--variants: no variant given");
+    return out;
+}
+
+// Applies a script at several voxel sizes and variants and measures every result against
+// the exact reference of its history. Each finished run is saved (its grid, mesh and row)
+// before the next starts, so an interrupted study resumes where it stopped.
+int runStudy(const StudyArgs& a) {
+    const StrokeScript script = readStrokeScript(a.script);
+    const std::vector<double> sizes = parseVoxelSizes(a.voxelSizes);
+    const std::vector<StudyVariant> variants = parseVariants(a.variants);
+    for (const double h : sizes)
+        requireBuildableStart(script, h, a.force); // the limits apply holds the script to
+    std::error_code ec;
+    std::filesystem::create_directories(a.dir, ec);
+    if (ec)
+        throw std::runtime_error(a.dir + ": cannot create the study directory (" + ec.message() +
+                                 ")");
+    const std::string csv = a.dir + "/study.csv", report = a.dir + "/report.md";
+    requireWritable(csv);
+    std::vector<StudyRow> earlier = readStudyCsv(csv);
+
+    std::vector<StudyRow> rows;
+    const std::size_t total = sizes.size() * variants.size();
+    std::size_t reused = 0;
+    for (const double h : sizes)
+        for (const StudyVariant v : variants) {
+            StudyRow planned;
+            planned.variant = variantName(v);
+            planned.voxelSize = h;
+            const std::string name = studyRunName(planned);
+            const std::string vdbPath = a.dir + "/" + name + ".vdb";
+            const auto done = std::find_if(earlier.begin(), earlier.end(), [&](const StudyRow& r) {
+                return r.variant == planned.variant && r.voxelSize == h && r.failure.empty();
+            });
+            if (done != earlier.end() && std::filesystem::exists(vdbPath)) {
+                rows.push_back(*done);
+                ++reused;
+                continue;
+            }
+            const std::size_t k = rows.size() + 1;
+            try {
+                const GridPtr start =
+                    makeStartGrid(script, directoryOf(a.script), h, &gStop, a.force);
+                const ExactReference::StartFunction shape =
+                    script.start.kind == StartShape::Kind::Sphere
+                        ? ExactReference::sphere(script.start.center, script.start.radius)
+                        : ExactReference::sampled(start->deepCopy());
+                StudyRun run = runStudyCase(
+                    start, script.strokes, shape, v, &gStop, [&](std::size_t i, std::size_t n) {
+                        if (!a.quiet)
+                            std::fprintf(stderr, "\rstudy: run %zu / %zu (%s): segment %zu / %zu ",
+                                         k, total, name.c_str(), i, n);
+                    });
+                AtomicWrite vdb = prepareLevelSet(*run.grid, vdbPath);
+                AtomicWrite mesh = prepareMesh(run.mesh, a.dir + "/" + name + ".ply");
+                vdb.commit();
+                mesh.commit();
+                rows.push_back(run.row);
+            } catch (const Cancelled&) {
+                throw;
+            } catch (const std::exception& e) {
+                // One failed run is reported in its row; the others still run.
+                planned.failure = e.what();
+                rows.push_back(planned);
+            }
+            if (!a.quiet) std::fprintf(stderr, "\n");
+            fillOrders(rows);
+            writeTextAtomically(csv, studyCsv(rows));
+        }
+    fillOrders(rows);
+    writeTextAtomically(csv, studyCsv(rows));
+    writeTextAtomically(report, studyReport(rows, a.script));
+    std::size_t failed = 0;
+    for (const StudyRow& r : rows)
+        failed += !r.failure.empty();
+    std::fprintf(stderr, "wrote %s and %s: %zu runs (%zu reused from before, %zu failed)\n",
+                 csv.c_str(), report.c_str(), rows.size(), reused, failed);
+    return failed == 0 ? 0 : 1;
+}
+
 } // namespace
 
 static int run(int argc, char** argv) {
@@ -370,6 +501,21 @@ static int run(int argc, char** argv) {
     recover->add_option("-o,--output", output, "Output .vdb")->required();
     recover->add_option("--script", scriptOut, "Also write the recovered stroke script (.json)");
 
+    StudyArgs studyArgs;
+    CLI::App* study = app.add_subcommand(
+        "study", "Apply a script at several voxel sizes and variants, measured against the "
+                 "exact shape its history defines");
+    study->add_option("script", studyArgs.script, "Stroke script (JSON)")->required();
+    study->add_option("-o,--output", studyArgs.dir, "Study directory")->required();
+    study->add_option("--voxel-sizes", studyArgs.voxelSizes,
+                      "Voxel sizes, decimals or 1/N (default 1/32,1/64,1/128,1/256)");
+    study->add_option("--variants", studyArgs.variants,
+                      "trilinear, cubic, per-substep, first-order (default trilinear)");
+    study->add_flag("-q,--quiet", studyArgs.quiet, "No progress output");
+    study->add_flag("--force", studyArgs.force,
+                    "Build start shapes even when they seem to need more memory than is free");
+    study->add_option("--threads", threads, "Worker threads")->check(CLI::Range(1, 1024));
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -386,6 +532,7 @@ static int run(int argc, char** argv) {
         if (*info) return runInfo(path, gridName, asJson);
         if (*apply) return runApply(applyArgs);
         if (*recover) return runRecover(path, output, scriptOut);
+        if (*study) return runStudy(studyArgs);
         if (*create) {
             requireSphereSize(radius, voxelSize);
             requireWritable(output);

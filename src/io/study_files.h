@@ -1,0 +1,25 @@
+// The files of a grid-resolution study: DIR/study.csv (one row per run, the columns
+// below) and DIR/report.md (the table and the observed orders, for reading at a glance).
+// The CSV is also what an interrupted study resumes from.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "study/study.h"
+
+namespace sweepers {
+
+// variant, voxel_size, wall_s, advect_s, renorm_s, mesh_s, peak_rss_mb, active_voxels,
+// volume, volume_change_pct, area, euler, genus, components, err_mean, err_rms, err_max,
+// err_rms_voxels, sign_flips, order_rms, err_samples, unmatched, failure
+std::string studyCsv(const std::vector<StudyRow>& rows);
+// Rows of a study.csv; a missing file has none. Throws FileError for a file that is not one.
+std::vector<StudyRow> readStudyCsv(const std::string& path);
+std::string studyReport(const std::vector<StudyRow>& rows, const std::string& script);
+
+// The run's file stem: <variant>_<N> with N = 1 / voxel size when that is whole
+// (trilinear_64), else the voxel size itself (trilinear_0.03).
+std::string studyRunName(const StudyRow& row);
+
+} // namespace sweepers

@@ -1,0 +1,224 @@
+#include "study/study.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include <openvdb/tools/Interpolation.h>
+#include <sys/resource.h>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "core/stopwatch.h"
+#include "levelset/measure.h"
+#include "mesh/marching_cubes.h"
+
+namespace sweepers {
+
+namespace {
+
+struct Tally {
+    double sum = 0.0, sumSq = 0.0, max = 0.0;
+    std::size_t count = 0, unmatched = 0, flips = 0;
+    void add(double e) {
+        sum += e;
+        sumSq += e * e;
+        max = std::max(max, e);
+        ++count;
+    }
+    void merge(const Tally& o) {
+        sum += o.sum;
+        sumSq += o.sumSq;
+        max = std::max(max, o.max);
+        count += o.count;
+        unmatched += o.unmatched;
+        flips += o.flips;
+    }
+};
+
+double peakRssMb() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return double(usage.ru_maxrss) / 1024.0; // ru_maxrss is in kilobytes on Linux
+}
+
+} // namespace
+
+std::string variantName(StudyVariant v) {
+    switch (v) {
+    case StudyVariant::Trilinear:
+        return "trilinear";
+    case StudyVariant::Cubic:
+        return "cubic";
+    case StudyVariant::PerSubStep:
+        return "per-substep";
+    case StudyVariant::FirstOrder:
+        return "first-order";
+    }
+    return "";
+}
+
+std::optional<StudyVariant> parseVariant(const std::string& name) {
+    for (StudyVariant v : {StudyVariant::Trilinear, StudyVariant::Cubic, StudyVariant::PerSubStep,
+                           StudyVariant::FirstOrder})
+        if (variantName(v) == name) return v;
+    return std::nullopt;
+}
+
+AdvectOptions variantOptions(StudyVariant v) {
+    AdvectOptions o;
+    o.sampling = v == StudyVariant::Cubic ? Sampling::MonotoneCubic : Sampling::Trilinear;
+    o.resampleEachSubStep = v == StudyVariant::PerSubStep;
+    o.renormalization = v == StudyVariant::FirstOrder ? FmmOrder::First : FmmOrder::Second;
+    return o;
+}
+
+InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
+                              const ExactReference& reference, Interrupter* interrupter) {
+    const double h = grid.voxelSize()[0];
+    const double tolerance = 1e-6 * h;
+    tbb::enumerable_thread_specific<Tally> tallies;
+
+    // Grid to reference: the reference's sign at every active voxel (sign flips), and its
+    // crossings on the edges between active voxels, whose distance to the grid's surface is
+    // the grid's interpolated value there (a distance near the surface once renormalized).
+    std::vector<const LeafNode*> leaves;
+    for (auto it = grid.tree().cbeginLeaf(); it; ++it)
+        leaves.push_back(&*it);
+    GridPtr signs = grid.deepCopy(); // the reference's values on the grid's active voxels
+    std::vector<LeafNode*> signLeaves;
+    for (auto it = signs->tree().beginLeaf(); it; ++it)
+        signLeaves.push_back(&*it);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, signLeaves.size()), [&](const auto& r) {
+        pollInterrupt(interrupter);
+        Tally& t = tallies.local();
+        for (std::size_t l = r.begin(); l != r.end(); ++l)
+            for (auto it = signLeaves[l]->beginValueOn(); it; ++it) {
+                const bool inside = *it < 0.0f;
+                const double v = reference.value(toEigen(grid.indexToWorld(it.getCoord())));
+                if ((v < 0.0) != inside) ++t.flips;
+                // Only the sign is kept; exact zeros count as outside, as in the grid.
+                it.setValue(v < 0.0 ? -1.0f : 1.0f);
+            }
+    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
+        pollInterrupt(interrupter);
+        Tally& t = tallies.local();
+        const auto refAcc = signs->getConstAccessor();
+        const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
+            grid.getConstAccessor(), grid.transform());
+        for (std::size_t l = r.begin(); l != r.end(); ++l)
+            for (auto it = leaves[l]->cbeginValueOn(); it; ++it) {
+                const openvdb::Coord ijk = it.getCoord();
+                const bool inside = refAcc.getValue(ijk) < 0.0f;
+                for (int a = 0; a < 3; ++a) {
+                    openvdb::Coord next = ijk;
+                    next[a] += 1;
+                    float other;
+                    if (!refAcc.probeValue(next, other) || (other < 0.0f) == inside) continue;
+                    const auto c = reference.crossing(toEigen(grid.indexToWorld(ijk)),
+                                                      toEigen(grid.indexToWorld(next)), tolerance);
+                    if (c) t.add(std::abs(double(sampler.wsSample(toVdb(*c)))));
+                }
+            }
+    });
+
+    // Mesh to reference: the nearest bracket along the normal that holds a crossing.
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, mesh.positions.size(), 256), [&](const auto& r) {
+            pollInterrupt(interrupter);
+            Tally& t = tallies.local();
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                const Eigen::Vector3d p = mesh.positions[i].cast<double>();
+                const Eigen::Vector3d n = i < mesh.normals.size()
+                                              ? mesh.normals[i].cast<double>().normalized()
+                                              : Eigen::Vector3d::UnitX();
+                std::optional<Eigen::Vector3d> c;
+                for (int reach = 1; reach <= int(InterfaceError::kSearchVoxels) && !c; ++reach)
+                    c = reference.crossing(p - reach * h * n, p + reach * h * n, tolerance);
+                if (c) {
+                    t.add((*c - p).norm());
+                } else {
+                    t.add(InterfaceError::kSearchVoxels * h);
+                    ++t.unmatched;
+                }
+            }
+        });
+
+    Tally all;
+    for (const Tally& t : tallies)
+        all.merge(t);
+    InterfaceError e;
+    e.samples = all.count;
+    e.unmatched = all.unmatched;
+    e.signFlips = all.flips;
+    if (all.count > 0) {
+        e.mean = all.sum / double(all.count);
+        e.rms = std::sqrt(all.sumSq / double(all.count));
+        e.max = all.max;
+    }
+    return e;
+}
+
+StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
+                      const ExactReference::StartFunction& startShape, StudyVariant variant,
+                      Interrupter* interrupter, const Progress& progress) {
+    StudyRun run;
+    StudyRow& row = run.row;
+    row.variant = variantName(variant);
+    row.voxelSize = start->voxelSize()[0];
+    const double startVolume = measureLevelSet(*start).volume;
+
+    AdvectOptions options = variantOptions(variant);
+    options.interrupter = interrupter;
+    Sculptor sculptor(std::move(start), options);
+    const auto t0 = Clock::now();
+    const std::vector<SegmentReport> reports = applyStrokes(sculptor, strokes, progress);
+    ExactReference reference(startShape);
+    for (const SegmentReport& r : reports) {
+        row.advectSeconds += r.stats.growSeconds + r.stats.sampleSeconds;
+        row.renormSeconds += r.stats.renormalizeSeconds;
+        reference.append(r.deformation);
+    }
+    const auto t1 = Clock::now();
+    SurfaceMesher mesher;
+    mesher.rebuild(sculptor.grid(), interrupter);
+    run.mesh = mesher.weld();
+    row.meshSeconds = secondsSince(t1);
+    row.wallSeconds = secondsSince(t0);
+    row.peakRssMb = peakRssMb();
+
+    run.grid = sculptor.gridPtr();
+    const LevelSetMeasures m = measureLevelSet(*run.grid);
+    row.activeVoxels = m.activeVoxels;
+    row.volume = m.volume;
+    row.volumeChangePct = 100.0 * (m.volume - startVolume) / startVolume;
+    row.area = m.area;
+    row.euler = m.eulerCharacteristic;
+    row.genus = m.genus;
+    row.components = m.components;
+    row.error = interfaceError(*run.grid, run.mesh, reference, interrupter);
+    return run;
+}
+
+void fillOrders(std::vector<StudyRow>& rows) {
+    std::map<std::string, std::vector<StudyRow*>> byVariant;
+    for (StudyRow& r : rows) {
+        r.orderRms = std::numeric_limits<double>::quiet_NaN();
+        if (r.failure.empty()) byVariant[r.variant].push_back(&r);
+    }
+    for (auto& [name, runs] : byVariant) {
+        std::sort(runs.begin(), runs.end(),
+                  [](const StudyRow* a, const StudyRow* b) { return a->voxelSize > b->voxelSize; });
+        for (std::size_t k = 1; k < runs.size(); ++k) {
+            const StudyRow& coarse = *runs[k - 1];
+            StudyRow& fine = *runs[k];
+            if (coarse.error.rms > 0.0 && fine.error.rms > 0.0 && coarse.voxelSize > fine.voxelSize)
+                fine.orderRms = std::log(coarse.error.rms / fine.error.rms) /
+                                std::log(coarse.voxelSize / fine.voxelSize);
+        }
+    }
+}
+
+} // namespace sweepers

@@ -1,0 +1,79 @@
+// Grid-resolution studies: one stroke script applied at a voxel size with a numerical
+// variant, measured against the exact reference of the same history (reference.h): how far
+// the result's surface lies from the true one, how many voxels are on the wrong side, the
+// volume, area and topology, and what the run cost.
+#pragma once
+
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "levelset/advect.h"
+#include "mesh/triangle_mesh.h"
+#include "sculpt/sculptor.h"
+#include "study/reference.h"
+
+namespace sweepers {
+
+enum class StudyVariant { Trilinear, Cubic, PerSubStep, FirstOrder };
+
+// trilinear, cubic, per-substep, first-order.
+std::string variantName(StudyVariant v);
+std::optional<StudyVariant> parseVariant(const std::string& name);
+// The engine's options for a variant: trilinear sampling of the composed inverse with
+// second-order fast marching, the monotone cubic of appendix C.1, one resample per sub-step
+// (5.3.4), or first-order fast marching.
+AdvectOptions variantOptions(StudyVariant v);
+
+// Distances between the result's surface and the reference's, both ways: from every vertex
+// of the result's mesh to the reference's crossing along the vertex normal, and from the
+// reference's crossings on the edges between active voxels to the grid's surface (the
+// grid's interpolated distance there).
+struct InterfaceError {
+    double mean = 0.0, rms = 0.0, max = 0.0; // world units
+    std::size_t samples = 0;
+    // Mesh vertices with no reference crossing within kSearchVoxels along their normal:
+    // counted at that distance (a lower bound of their error).
+    std::size_t unmatched = 0;
+    std::size_t signFlips = 0; // active voxels on the other side of the reference surface
+    static constexpr double kSearchVoxels = 3.0;
+};
+InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
+                              const ExactReference& reference, Interrupter* interrupter = nullptr);
+
+struct StudyRow {
+    std::string variant;
+    double voxelSize = 0.0;
+    double wallSeconds = 0.0, advectSeconds = 0.0, renormSeconds = 0.0, meshSeconds = 0.0;
+    double peakRssMb = 0.0; // the process's peak so far (runs go from coarse to fine)
+    std::size_t activeVoxels = 0;
+    double volume = 0.0, volumeChangePct = 0.0, area = 0.0;
+    int euler = 0, genus = 0;
+    std::size_t components = 0;
+    InterfaceError error;
+    // Observed order of the RMS error against the next coarser run of the same variant
+    // (NaN for the coarsest): p = log(e_coarse / e_fine) / log(h_coarse / h_fine).
+    double orderRms = std::numeric_limits<double>::quiet_NaN();
+    std::string failure; // why the run failed; empty when it ran
+};
+
+// A run's result: the sculpted grid, its welded mesh and its row.
+struct StudyRun {
+    GridPtr grid;
+    TriangleMesh mesh;
+    StudyRow row;
+};
+
+// Applies `strokes` to `start` (which the run takes over) with the variant's options and
+// measures the result against the exact reference built from `startShape` and the history
+// the run applied. `progress` sees segments done and in all.
+StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
+                      const ExactReference::StartFunction& startShape, StudyVariant variant,
+                      Interrupter* interrupter = nullptr, const Progress& progress = {});
+
+// Fills orderRms of every row from the next coarser row of its variant (failed rows and
+// rows without a coarser one get NaN).
+void fillOrders(std::vector<StudyRow>& rows);
+
+} // namespace sweepers

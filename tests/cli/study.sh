@@ -1,0 +1,119 @@
+#!/usr/bin/env bash
+# sweepers-cli study: a script replayed at several voxel sizes and variants and measured
+# against the exact shape its history defines. Checked here: the table's columns and rows,
+# the error of a translated sphere against the analytic sphere computed independently,
+# the convergence of the rigid-motion study, resuming after a SIGKILL without redoing
+# finished runs, and every refusal with its exact message.
+set -euo pipefail
+cli=$1
+data=$2
+py=/usr/bin/python3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+refuses() {
+  local expected=$1
+  shift
+  if "$cli" "$@" 2>"$tmp/err"; then fail "accepted: $*"; fi
+  [ "$(cat "$tmp/err")" = "$expected" ] || fail "$*: '$(cat "$tmp/err")', expected '$expected'"
+  echo "refused: $expected"
+}
+
+# --- a translated sphere: the study's error against an independent measure ------------
+cat >"$tmp/translate.json" <<'EOF'
+{ "sweepers": 1, "grid": { "voxel_size": 0.03125, "half_width": 3 },
+  "start": { "sphere": { "center": [0, 0, 0], "radius": 0.5 } },
+  "strokes": [ { "type": "sweep", "tools": [ { "shape": "ball", "size": 1.5, "falloff": 0.5,
+    "path": [ { "t": [0, 0, 0] }, { "t": [0.2, 0.1, 0] } ] } ] } ] }
+EOF
+"$cli" study "$tmp/translate.json" -o "$tmp/t" --voxel-sizes 1/32,1/64 \
+  --variants trilinear,first-order -q
+"$py" - "$tmp/t" <<'PY'
+import csv, math, struct, sys
+d = sys.argv[1]
+rows = list(csv.DictReader(open(f"{d}/study.csv")))
+columns = ("variant voxel_size wall_s advect_s renorm_s mesh_s peak_rss_mb active_voxels volume "
+           "volume_change_pct area euler genus components err_mean err_rms err_max "
+           "err_rms_voxels sign_flips order_rms").split()
+missing = [c for c in columns if c not in rows[0]]
+assert not missing, f"columns missing: {missing}"
+assert [(r["variant"], float(r["voxel_size"])) for r in rows] == [
+    ("trilinear", 1 / 32), ("first-order", 1 / 32), ("trilinear", 1 / 64),
+    ("first-order", 1 / 64)], rows
+for r in rows:
+    assert r["failure"] == "" and int(r["euler"]) == 2 and int(r["components"]) == 1, r
+# Independently: the distance of every vertex of the exported mesh to the moved sphere
+# (a binary PLY whose vertices are float properties, x y z first).
+data = open(f"{d}/trilinear_64.ply", "rb").read()
+header, body = data.split(b"end_header\n", 1)
+lines = header.decode().splitlines()
+start = next(i for i, l in enumerate(lines) if l.startswith("element vertex"))
+count = int(lines[start].split()[2])
+props = 0
+for l in lines[start + 1:]:
+    if not l.startswith("property"):
+        break
+    assert l.split()[1] == "float", l
+    props += 1
+err = []
+for i in range(count):
+    x, y, z = struct.unpack_from("<3f", body, i * 4 * props)
+    err.append(math.dist((x, y, z), (0.2, 0.1, 0.0)) - 0.5)
+independent = math.sqrt(sum(e * e for e in err) / len(err))
+study = float(rows[2]["err_rms"])
+print(f"translated sphere at 1/64: study err_rms {study:.3g}, mesh to analytic sphere {independent:.3g}")
+assert abs(study - independent) < 0.05 * independent, (study, independent)
+PY
+
+# --- the rigid-motion study converges --------------------------------------------------
+"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/rigid" --voxel-sizes 1/16,1/32,1/64 -q
+"$py" - "$tmp/rigid/study.csv" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+errs = [float(r["err_rms"]) for r in rows]
+orders = [float(r["order_rms"]) for r in rows[1:]]
+print("rigid motion, trilinear: err_rms", errs, "orders", orders)
+assert errs[0] > errs[1] > errs[2], errs
+assert all(p >= 1.0 for p in orders), orders
+PY
+grep -q "| trilinear | 1/64 |" "$tmp/rigid/report.md" || fail "report.md lacks the 1/64 row"
+
+# --- resuming after a SIGKILL ------------------------------------------------------------
+"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/128 \
+  -q &
+pid=$!
+for _ in $(seq 1 400); do
+  [ -f "$tmp/killed/study.csv" ] && [ "$(wc -l <"$tmp/killed/study.csv")" -ge 3 ] && break
+  sleep 0.025
+done
+kill -9 "$pid" 2>/dev/null || true
+wait "$pid" 2>/dev/null || true
+done_rows=$(($(wc -l <"$tmp/killed/study.csv") - 1))
+[ "$done_rows" -ge 2 ] || fail "the study wrote $done_rows rows before it was killed"
+stamp() { stat -c %y "$tmp/killed/trilinear_16.vdb" "$tmp/killed/trilinear_32.vdb"; }
+before=$(stamp)
+"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/128 \
+  -q 2>"$tmp/err"
+grep -q "3 runs ($done_rows reused from before, 0 failed)" "$tmp/err" ||
+  fail "resume: $(cat "$tmp/err"), expected $done_rows reused"
+[ "$(stamp)" = "$before" ] || fail "a finished run was redone"
+[ "$(wc -l <"$tmp/killed/study.csv")" -eq 4 ] || fail "the resumed table does not hold 3 rows"
+if ls "$tmp/killed" | grep -q "tmp-"; then fail "temporary files left: $(ls "$tmp/killed")"; fi
+echo "resumed after SIGKILL: $done_rows of 3 runs reused"
+
+# --- refusals: one line, nothing written -------------------------------------------------
+s="$data/studies/rigid_motion.json"
+refuses "sweepers-cli: --voxel-sizes: no voxel size given" study "$s" -o "$tmp/bad" --voxel-sizes ""
+refuses "sweepers-cli: --voxel-sizes: '-0.1' is not a positive size" \
+  study "$s" -o "$tmp/bad" --voxel-sizes=-0.1
+refuses "sweepers-cli: --voxel-sizes: 'fine' is not a voxel size (a decimal such as 0.02, or 1/N)" \
+  study "$s" -o "$tmp/bad" --voxel-sizes 1/32,fine
+refuses "sweepers-cli: a sphere of radius 0.5 at voxel size 1e-09 is 5e+08 voxels in radius; use 1.5 to 100000" \
+  study "$s" -o "$tmp/bad" --voxel-sizes 1e-9
+refuses "sweepers-cli: --variants: unknown variant 'quintic' (trilinear, cubic, per-substep, first-order)" \
+  study "$s" -o "$tmp/bad" --variants trilinear,quintic
+[ ! -e "$tmp/bad" ] || fail "a refused study left $tmp/bad"
+touch "$tmp/file"
+refuses "sweepers-cli: $tmp/file/study: cannot create the study directory (Not a directory)" \
+  study "$s" -o "$tmp/file/study"
+echo "study: all checks passed"

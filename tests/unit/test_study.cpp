@@ -1,0 +1,80 @@
+// The pieces of a grid-resolution study that need no grid: variants, observed orders, and
+// the table a study resumes from.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "io/study_files.h"
+#include "io/vdb_file.h"
+#include "study/study.h"
+
+using namespace sweepers;
+
+namespace {
+
+StudyRow row(const std::string& variant, double h, double rms) {
+    StudyRow r;
+    r.variant = variant;
+    r.voxelSize = h;
+    r.error.rms = rms;
+    r.error.samples = 100;
+    r.volume = 0.5;
+    r.euler = 2;
+    r.components = 1;
+    return r;
+}
+
+TEST(Study, VariantNamesRoundTrip) {
+    for (StudyVariant v : {StudyVariant::Trilinear, StudyVariant::Cubic, StudyVariant::PerSubStep,
+                           StudyVariant::FirstOrder})
+        EXPECT_EQ(parseVariant(variantName(v)), v);
+    EXPECT_FALSE(parseVariant("quintic"));
+    EXPECT_TRUE(variantOptions(StudyVariant::PerSubStep).resampleEachSubStep);
+    EXPECT_EQ(variantOptions(StudyVariant::Cubic).sampling, Sampling::MonotoneCubic);
+    EXPECT_EQ(variantOptions(StudyVariant::FirstOrder).renormalization, FmmOrder::First);
+}
+
+TEST(Study, OrdersCompareEachRunWithTheNextCoarserOfItsVariant) {
+    std::vector<StudyRow> rows = {row("trilinear", 1.0 / 32, 4e-3), row("cubic", 1.0 / 32, 1e-3),
+                                  row("trilinear", 1.0 / 64, 1e-3), row("cubic", 1.0 / 64, 5e-4),
+                                  row("trilinear", 1.0 / 128, 5e-4)};
+    rows.push_back(row("cubic", 1.0 / 128, 0.0));
+    rows.back().failure = "out of memory";
+    fillOrders(rows);
+    EXPECT_TRUE(std::isnan(rows[0].orderRms));
+    EXPECT_TRUE(std::isnan(rows[1].orderRms));
+    EXPECT_NEAR(rows[2].orderRms, 2.0, 1e-12);
+    EXPECT_NEAR(rows[3].orderRms, 1.0, 1e-12);
+    EXPECT_NEAR(rows[4].orderRms, 1.0, 1e-12);
+    EXPECT_TRUE(std::isnan(rows[5].orderRms));
+}
+
+TEST(Study, TableReadsBackWhatWasWritten) {
+    std::vector<StudyRow> rows = {row("trilinear", 1.0 / 32, 4e-3),
+                                  row("trilinear", 1.0 / 64, 1e-3)};
+    rows[1].error.signFlips = 7;
+    rows[1].wallSeconds = 1.25;
+    rows.push_back(row("cubic", 0.03, 0.0));
+    rows.back().failure = "a \"quoted\", comma'd reason";
+    fillOrders(rows);
+    const std::string path = ::testing::TempDir() + "study_table.csv";
+    std::ofstream(path) << studyCsv(rows);
+    const std::vector<StudyRow> back = readStudyCsv(path);
+    ASSERT_EQ(back.size(), 3u);
+    EXPECT_EQ(back[1].variant, "trilinear");
+    EXPECT_EQ(back[1].voxelSize, 1.0 / 64); // exactly: resuming matches runs by it
+    EXPECT_EQ(back[1].error.signFlips, 7u);
+    EXPECT_DOUBLE_EQ(back[1].wallSeconds, 1.25);
+    EXPECT_NEAR(back[1].orderRms, 2.0, 1e-3);
+    EXPECT_EQ(back[2].failure, rows[2].failure);
+    EXPECT_EQ(studyRunName(back[1]), "trilinear_64");
+    EXPECT_EQ(studyRunName(back[2]), "cubic_0.03");
+    std::ofstream(path) << "not,a,study\n";
+    EXPECT_THROW(readStudyCsv(path), FileError);
+    std::remove(path.c_str());
+    EXPECT_TRUE(readStudyCsv(path).empty()); // no table yet: nothing to resume
+}
+
+} // namespace
