@@ -417,6 +417,13 @@ int runStudy(const StudyArgs& a) {
         failed += !r.failure.empty();
     std::fprintf(stderr, "wrote %s and %s: %zu runs (%zu reused from before, %zu failed)\n",
                  csv.c_str(), report.c_str(), rows.size(), reused, failed);
+    // The table stands without the plots: a plot that cannot be drawn is said, not fatal to it.
+    try {
+        writeStudyPlots(rows, a.dir, a.script);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "sweepers-cli: %s\n", e.what());
+        return 1;
+    }
     return failed == 0 ? 0 : 1;
 }
 

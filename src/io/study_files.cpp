@@ -1,10 +1,18 @@
 #include "io/study_files.h"
 
+#include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
 
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "io/atomic_file.h"
 #include "io/vdb_file.h"
 
 namespace sweepers {
@@ -79,7 +87,125 @@ double voxelsOf(const StudyRow& r) {
     return r.voxelSize > 0.0 ? r.error.rms / r.voxelSize : 0.0;
 }
 
+std::string quoted(const std::string& s) {
+    std::string out = "\"";
+    for (const char c : s) {
+        if (c == '"' || c == '\\') out += '\\';
+        out += c;
+    }
+    return out + "\"";
+}
+
+// Runs gnuplot on `script` in `dir` with `terminal` set first; returns what it drew (its
+// standard output).
+std::string runGnuplot(const std::string& dir, const std::string& script,
+                       const std::string& terminal) {
+    int out[2];
+    if (::pipe(out) != 0) throw std::runtime_error("plots: cannot start gnuplot (pipe)");
+    const pid_t pid = ::fork();
+    if (pid < 0) {
+        ::close(out[0]);
+        ::close(out[1]);
+        throw std::runtime_error("plots: cannot start gnuplot (fork)");
+    }
+    if (pid == 0) {
+        ::dup2(out[1], STDOUT_FILENO);
+        ::close(out[0]);
+        ::close(out[1]);
+        if (::chdir(dir.c_str()) != 0) ::_exit(126);
+        const std::string set = "set terminal " + terminal;
+        ::execlp("gnuplot", "gnuplot", "-e", set.c_str(), script.c_str(), (char*)nullptr);
+        ::_exit(errno == ENOENT ? 127 : 126);
+    }
+    ::close(out[1]);
+    std::string image;
+    char buf[65536];
+    for (;;) {
+        const ssize_t n = ::read(out[0], buf, sizeof buf);
+        if (n > 0)
+            image.append(buf, std::size_t(n));
+        else if (n == 0 || errno != EINTR)
+            break;
+    }
+    ::close(out[0]);
+    int status = 0;
+    while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
+        throw std::runtime_error("plots: gnuplot is not installed (Debian: gnuplot-nox)");
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || image.empty())
+        throw std::runtime_error("plots: gnuplot failed on " + dir + "/" + script);
+    return image;
+}
+
 } // namespace
+
+void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir,
+                     const std::string& script) {
+    // One data block per variant (gnuplot breaks a line at every row it skips, and the table
+    // interleaves the variants): voxel size, RMS error, volume change, time, peak memory.
+    std::vector<std::string> variants;
+    std::set<double> sizes;
+    std::ostringstream blocks;
+    const StudyRow* first = nullptr;
+    for (const StudyRow& r : rows)
+        if (r.failure.empty() &&
+            std::find(variants.begin(), variants.end(), r.variant) == variants.end())
+            variants.push_back(r.variant);
+    for (std::size_t v = 0; v < variants.size(); ++v) {
+        blocks << "$v" << v << " << EOD\n";
+        for (const StudyRow& r : rows) {
+            if (!r.failure.empty() || r.variant != variants[v]) continue;
+            if (!first) first = &r;
+            sizes.insert(r.voxelSize);
+            blocks << number(r.voxelSize, 17) << " " << number(r.error.rms) << " "
+                   << number(r.volumeChangePct) << " " << number(r.wallSeconds) << " "
+                   << number(r.peakRssMb) << "\n";
+        }
+        blocks << "EOD\n";
+    }
+    if (!first) throw std::runtime_error("plots: no run finished, nothing to draw");
+    // Guides through the first run's error: e = a h and e = b h^2.
+    const double h0 = first->voxelSize, e0 = std::max(first->error.rms, 1e-300);
+    std::string tics;
+    for (const double h : sizes)
+        tics +=
+            (tics.empty() ? "" : ", ") + quoted("1/" + number(1.0 / h, 6)) + " " + number(h, 17);
+    const auto series = [&](int column) {
+        std::ostringstream p;
+        p << "plot ";
+        for (std::size_t v = 0; v < variants.size(); ++v)
+            p << (v ? ", " : "") << "$v" << v << " using 1:" << column
+              << " with linespoints pointtype 7 linecolor " << v + 1 << " title "
+              << quoted(variants[v]);
+        return p.str();
+    };
+    std::ostringstream gp;
+    gp << "# Drawn by sweepers-cli study; to draw it again:\n"
+       << "#   gnuplot -e 'set terminal pngcairo size 1280,960' convergence.gp > convergence.png\n"
+       << blocks.str() << "set multiplot layout 2,2 title "
+       << quoted("Grid-resolution study of " + script) << " noenhanced\n"
+       << "set grid\nset logscale x\nset xtics (" << tics << ")\nset xlabel 'voxel size'\n"
+       << "set format y '%g'\nset key bottom right\n"
+       << "set logscale y\nset ylabel 'RMS distance to the exact surface'\n"
+       << "set title 'interface error'\n"
+       << series(2) << ", " << number(e0 / h0, 17) << " * x dashtype 2 linecolor 'gray' "
+       << "title 'slope 1', " << number(e0 / (h0 * h0), 17)
+       << " * x**2 dashtype 3 linecolor 'black' title 'slope 2'\n"
+       << "unset key\nunset logscale y\nset ylabel 'volume change (%)'\n"
+       << "set title 'volume drift'\n"
+       << series(3) << "\n"
+       << "set logscale y\nset ylabel 'seconds'\nset title 'time'\n"
+       << series(4) << "\n"
+       << "set ylabel 'MB'\nset title 'peak memory (of the process so far)'\n"
+       << series(5) << "\n"
+       << "unset multiplot\n";
+    writeTextAtomically(dir + "/convergence.gp", gp.str());
+    const std::string png = runGnuplot(dir, "convergence.gp", "pngcairo size 1280,960");
+    const std::string svg = runGnuplot(dir, "convergence.gp", "svg size 1280,960");
+    writeTextAtomically(dir + "/convergence.png", png);
+    writeTextAtomically(dir + "/convergence.svg", svg);
+}
 
 std::string studyRunName(const StudyRow& row) {
     const double n = 1.0 / row.voxelSize;

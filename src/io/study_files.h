@@ -18,6 +18,14 @@ std::string studyCsv(const std::vector<StudyRow>& rows);
 std::vector<StudyRow> readStudyCsv(const std::string& path);
 std::string studyReport(const std::vector<StudyRow>& rows, const std::string& script);
 
+// DIR/convergence.gp, and from it DIR/convergence.png and DIR/convergence.svg drawn by
+// gnuplot: the RMS error against the voxel size per variant (log-log, with slope-1 and
+// slope-2 guides), the volume change, the time and the peak memory against the voxel size.
+// Each file is written atomically. Throws std::runtime_error when gnuplot cannot draw them
+// (for example when it is not installed).
+void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir,
+                     const std::string& script);
+
 // The run's file stem: <variant>_<N> with N = 1 / voxel size when that is whole
 // (trilinear_64), else the voxel size itself (trilinear_0.03).
 std::string studyRunName(const StudyRow& row);

@@ -64,6 +64,9 @@ study = float(rows[2]["err_rms"])
 print(f"translated sphere at 1/64: study err_rms {study:.3g}, mesh to analytic sphere {independent:.3g}")
 assert abs(study - independent) < 0.05 * independent, (study, independent)
 PY
+for f in study.csv report.md convergence.gp convergence.png convergence.svg; do
+  [ -s "$tmp/t/$f" ] || fail "the study of two sizes and two variants wrote no $f"
+done
 
 # --- the rigid-motion study converges --------------------------------------------------
 "$cli" study "$data/studies/rigid_motion.json" -o "$tmp/rigid" --voxel-sizes 1/16,1/32,1/64 -q
@@ -77,6 +80,20 @@ assert errs[0] > errs[1] > errs[2], errs
 assert all(p >= 1.0 for p in orders), orders
 PY
 grep -q "| trilinear | 1/64 |" "$tmp/rigid/report.md" || fail "report.md lacks the 1/64 row"
+"$py" - "$tmp/rigid" <<'PY'
+import sys, xml.etree.ElementTree as ET
+from PIL import Image
+d = sys.argv[1]
+png = Image.open(f"{d}/convergence.png")
+png.load()
+assert png.size == (1280, 960), png.size
+# Something is drawn: many distinct colours, not a blank page.
+assert len(png.convert("RGB").getcolors(1 << 20) or []) > 8
+root = ET.parse(f"{d}/convergence.svg").getroot()
+assert root.tag.endswith("svg"), root.tag
+assert sum(1 for e in root.iter() if e.tag.endswith("path")) > 10
+print("plots: convergence.png 1280x960 and a valid convergence.svg")
+PY
 
 # --- resuming after a SIGKILL ------------------------------------------------------------
 "$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/128 \
