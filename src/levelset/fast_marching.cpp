@@ -316,10 +316,10 @@ class Marcher {
         });
     }
 
-    // The voxels of a leaf with a face neighbour in `other` along some axis: one of the
+    // The voxels of a leaf with a face neighbour in a set along some axis: one of the two
     // neighbours when `both` is false, both of them along one axis when it is true.
-    // `other(A, dir, bits)` gives, per voxel, whether its neighbour one step along axis A is
-    // in the set (Domain::stepped of some set).
+    // `other(axis, dir, out, valid)` gives, per voxel, whether its neighbour one step along
+    // the axis is in the set, and whether it has one in the domain (Domain::stepped).
     template <typename Other> static Bits nextTo(bool both, const Other& other) {
         Bits any{};
         forEachAxis([&](auto a) {
