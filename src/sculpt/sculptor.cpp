@@ -68,7 +68,8 @@ SegmentReport Sculptor::applyStroke(const Stroke& stroke,
 
 std::vector<SegmentReport> applyStrokes(Sculptor& sculptor, const std::vector<Stroke>& strokes,
                                         const Progress& progress,
-                                        const std::function<void(std::size_t)>& after) {
+                                        const std::function<void(std::size_t)>& after,
+                                        History* history) {
     std::size_t total = 0, done = 0;
     for (const Stroke& s : strokes)
         total += segmentCount(s);
@@ -77,6 +78,8 @@ std::vector<SegmentReport> applyStrokes(Sculptor& sculptor, const std::vector<St
         sculptor.applyStroke(strokes[i], [&](const SegmentReport& r) {
             reports.push_back(r);
             reports.back().stroke = i;
+            if (history) history->push_back(r.deformation);
+            reports.back().deformation.reset();
             if (sculptor.meshing()) reports.back().meshVolume = sculptor.mesher().enclosedVolume();
             if (progress) progress(++done, total);
         });

@@ -80,10 +80,15 @@ class Sculptor {
     LeafSnapshot record_;
 };
 
+// The deformations a run applied, in order.
+using History = std::vector<std::shared_ptr<const StepDeformation>>;
+
 // Applies strokes in order, reporting every segment (stroke index and segment within it);
-// `after` (if set) runs after each stroke with its index.
+// `after` (if set) runs after each stroke with its index. The reports do not keep the
+// deformations (a long script would hold them all): `history`, if set, receives them.
 std::vector<SegmentReport> applyStrokes(Sculptor& sculptor, const std::vector<Stroke>& strokes,
                                         const Progress& progress = {},
-                                        const std::function<void(std::size_t)>& after = {});
+                                        const std::function<void(std::size_t)>& after = {},
+                                        History* history = nullptr);
 
 } // namespace sweepers

@@ -174,13 +174,16 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
     options.interrupter = interrupter;
     Sculptor sculptor(std::move(start), options);
     const auto t0 = Clock::now();
-    const std::vector<SegmentReport> reports = applyStrokes(sculptor, strokes, progress);
-    ExactReference reference(startShape);
+    History history;
+    const std::vector<SegmentReport> reports =
+        applyStrokes(sculptor, strokes, progress, {}, &history);
     for (const SegmentReport& r : reports) {
         row.advectSeconds += r.stats.growSeconds + r.stats.sampleSeconds;
         row.renormSeconds += r.stats.renormalizeSeconds;
-        reference.append(r.deformation);
     }
+    ExactReference reference(startShape);
+    for (auto& d : history)
+        reference.append(std::move(d));
     const auto t1 = Clock::now();
     SurfaceMesher mesher;
     mesher.rebuild(sculptor.grid(), interrupter);

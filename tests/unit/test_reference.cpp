@@ -86,8 +86,10 @@ TEST(ExactReference, TwistedLimbAgreesWithTheGridWithinAVoxel) {
     const double h = 1.0 / 32.0;
     Sculptor sculptor(makeSphere(script.start.center, script.start.radius, h, 3.0));
     ExactReference ref(ExactReference::sphere(script.start.center, script.start.radius));
-    for (const SegmentReport& r : applyStrokes(sculptor, script.strokes))
-        ref.append(r.deformation);
+    History history;
+    applyStrokes(sculptor, script.strokes, {}, {}, &history);
+    for (auto& d : history)
+        ref.append(std::move(d));
     ASSERT_GT(ref.size(), 2u);
 
     const Grid& grid = sculptor.grid();
