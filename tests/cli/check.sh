@@ -1,11 +1,7 @@
 #!/usr/bin/env bash
 # sweepers-cli check on real scripts: a valid one prints its plan, a bad one fails with one
 # line on stderr that names the file, the location and the reason.
-set -euo pipefail
-cli=$1
-data=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/common.sh" "$@"
 
 "$cli" check "$data/pull.json" >"$tmp/out"
 grep -q "segment 0: 1 tool(s), 2 sub-steps" "$tmp/out" || { cat "$tmp/out"; exit 1; }

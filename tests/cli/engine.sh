@@ -2,13 +2,7 @@
 # sweepers-cli end to end: real scripts in, VDB and meshes out, read back by independent
 # readers (vdb_print from libopenvdb-tools, pyopenvdb under Debian's python3); every
 # failure path exits non-zero with one line on stderr and leaves no output file.
-set -euo pipefail
-cli=$1
-data=$2
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/common.sh" "$@"
 
 # --- new, read by vdb_print and pyopenvdb ------------------------------------------
 "$cli" new -o "$tmp/sphere.vdb" --radius 0.5 --voxel-size 0.025

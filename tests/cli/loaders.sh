@@ -7,18 +7,12 @@
 # exit and no output; then a fixed corpus of damaged VDB, PLY, OBJ, STL and JSON files must
 # each end in success or such a refusal, within a time bound, never a crash (OpenVDB's
 # reader, which crashes on some of them, runs in a child process).
-set -euo pipefail
-cli=$1
-data=$2
+. "$(dirname "$0")/common.sh" "$@"
 here=$(cd "$(dirname "$0")" && pwd)
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
 cd "$tmp"
 
 # Runs the CLI expecting a refusal whose one line contains `message`, and no output file.
-refuses() {
+rejects() {
   local message=$1
   shift
   local rc=0
@@ -66,18 +60,18 @@ for f in good past_end negative infinite nan enormous announces announces_binary
   script_for $f.ply 0.05
 done
 "$cli" apply good.ply.json -q -o good.vdb || fail "the good tetrahedron was refused"
-refuses "face 3 refers to vertex 99, but the mesh has 4 vertices" apply past_end.ply.json -q
-refuses "face 3 refers to vertex -5, but the mesh has 4 vertices" apply negative.ply.json -q
-refuses "1 vertices have coordinates that are not finite numbers" apply infinite.ply.json -q
-refuses "1 vertices have coordinates that are not finite numbers" apply nan.ply.json -q
-refuses "the start shape needs about" apply enormous.ply.json -q
+rejects "face 3 refers to vertex 99, but the mesh has 4 vertices" apply past_end.ply.json -q
+rejects "face 3 refers to vertex -5, but the mesh has 4 vertices" apply negative.ply.json -q
+rejects "1 vertices have coordinates that are not finite numbers" apply infinite.ply.json -q
+rejects "1 vertices have coordinates that are not finite numbers" apply nan.ply.json -q
+rejects "the start shape needs about" apply enormous.ply.json -q
 grep -q "more than the .* available; use a coarser voxel size, or --force" err ||
   fail "the memory refusal does not say what to do: $(cat err)"
-refuses "announces.ply: the header announces 2147483648 vertex elements, more than the file's 80 bytes of data can hold (a damaged header?)" \
+rejects "announces.ply: the header announces 2147483648 vertex elements, more than the file's 80 bytes of data can hold (a damaged header?)" \
   apply announces.ply.json -q
-refuses "announces_binary.ply: the header announces 100000000 face elements, more than the file's 100 bytes of data can hold (a damaged header?)" \
+rejects "announces_binary.ply: the header announces 100000000 face elements, more than the file's 100 bytes of data can hold (a damaged header?)" \
   apply announces_binary.ply.json -q
-refuses "the mesh is not closed (3 edges border a single triangle), so it has no inside" \
+rejects "the mesh is not closed (3 edges border a single triangle), so it has no inside" \
   apply open.ply.json -q
 
 # --- level sets: non-finite values, no surface --------------------------------------------
@@ -150,9 +144,9 @@ cmp -s named.obj big_alone.obj || fail "the start grid named 'big' is not the sp
 printf '{"sweepers": 1, "grid": {"voxel_size": 0.02}, "start": {"vdb": "multi.vdb"}, "strokes": []}' >h.json
 printf '{"sweepers": 1, "grid": {"half_width": 4}, "start": {"vdb": "multi.vdb"}, "strokes": []}' >hw.json
 printf '{"sweepers": 1, "start": {"vdb": "multi.vdb"}, "strokes": []}' >plain.json
-refuses "multi.vdb: its voxel size 0.05 differs from the script's /grid/voxel_size 0.02 (a VDB start keeps its own grid: give 0.05 or leave the setting out)" apply h.json
-refuses "multi.vdb: its band half-width 3 differs from the script's /grid/half_width 4" apply hw.json
-refuses "multi.vdb: its voxel size 0.05 differs from --voxel-size 0.1" apply plain.json --voxel-size 0.1
+rejects "multi.vdb: its voxel size 0.05 differs from the script's /grid/voxel_size 0.02 (a VDB start keeps its own grid: give 0.05 or leave the setting out)" apply h.json
+rejects "multi.vdb: its band half-width 3 differs from the script's /grid/half_width 4" apply hw.json
+rejects "multi.vdb: its voxel size 0.05 differs from --voxel-size 0.1" apply plain.json --voxel-size 0.1
 "$cli" apply plain.json -o plain.vdb -q || fail "apply from the first usable grid of a file"
 
 # --- scripts: duplicate keys, sizes check refuses as apply does ---------------------------
@@ -178,7 +172,7 @@ done
 # --- a fixed corpus of damaged files ---------------------------------------------------------
 "$cli" new -o small.vdb --voxel-size 0.1 --radius 0.5
 for ext in ply obj stl; do "$cli" mesh small.vdb -o "small.$ext" 2>/dev/null; done
-# 300 cases, all of them under the sanitizers too (about 80 s there).
+# 300 cases, all of them under the sanitizers too (80 to 150 s there, by machine).
 for ext in ply obj stl; do "$py" "$here/mutate.py" "small.$ext" corpus 40 7; done
 "$py" "$here/mutate.py" "$data/horn.json" corpus 60 7
 "$py" "$here/mutate.py" small.vdb corpus 120 7

@@ -3,22 +3,8 @@
 # would leave them: the history they hold (undo included) rebuilt to the grid that
 # `apply` makes of the same strokes; a record cut short by the crash or a damaged one; and
 # every refusal, each with its exact message.
-set -euo pipefail
-cli=$1
-data=$2
-py=/usr/bin/python3
+. "$(dirname "$0")/common.sh" "$@"
 here=$(cd "$(dirname "$0")" && pwd)
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
-# The message of a command that must fail: exit 1 and exactly this line on stderr.
-refuses() {
-  local expected=$1
-  shift
-  if "$cli" "$@" 2>"$tmp/err"; then fail "accepted: $*"; fi
-  [ "$(cat "$tmp/err")" = "$expected" ] || fail "$*: '$(cat "$tmp/err")', expected '$expected'"
-  echo "refused: $expected"
-}
 
 # A session of four edits and an undo, at a coarse voxel size: a sweep, two swirls, a dab
 # of clay (undone), one more swirl. expected.json holds the history it leaves.

@@ -4,20 +4,7 @@
 # the error of a translated sphere against the analytic sphere computed independently,
 # the convergence of the rigid-motion study, resuming after a SIGKILL without redoing
 # finished runs, and every refusal with its exact message.
-set -euo pipefail
-cli=$1
-data=$2
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
-refuses() {
-  local expected=$1
-  shift
-  if "$cli" "$@" 2>"$tmp/err"; then fail "accepted: $*"; fi
-  [ "$(cat "$tmp/err")" = "$expected" ] || fail "$*: '$(cat "$tmp/err")', expected '$expected'"
-  echo "refused: $expected"
-}
+. "$(dirname "$0")/common.sh" "$@"
 
 # --- a translated sphere: the study's error against an independent measure ------------
 cat >"$tmp/translate.json" <<'EOF'
