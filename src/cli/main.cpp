@@ -399,7 +399,15 @@ int runStudy(const StudyArgs& a) {
                 mesh.commit();
                 rows.push_back(run.row);
             } catch (const Cancelled&) {
-                throw;
+                // The finished runs are on disk already: say so, rather than "nothing was
+                // written".
+                writeTextAtomically(csv, studyCsv(rows));
+                if (!a.quiet) std::fprintf(stderr, "\n"); // ends the progress line
+                std::fprintf(stderr,
+                             "sweepers-cli: interrupted after %zu of %zu runs; they are in %s "
+                             "(the same command resumes the study)\n",
+                             rows.size(), total, csv.c_str());
+                return 130;
             } catch (const std::exception& e) {
                 // One failed run is reported in its row; the others still run.
                 planned.failure = e.what();

@@ -105,6 +105,22 @@ grep -q "3 runs ($done_rows reused from before, 0 failed)" "$tmp/err" ||
 if ls "$tmp/killed" | grep -q "tmp-"; then fail "temporary files left: $(ls "$tmp/killed")"; fi
 echo "resumed after SIGKILL: $done_rows of 3 runs reused"
 
+# --- Ctrl-C: the finished runs are kept and said ------------------------------------------
+"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/stopped" --voxel-sizes 1/16,1/128 -q \
+  2>"$tmp/stopped.err" &
+pid=$!
+for _ in $(seq 1 400); do
+  [ -f "$tmp/stopped/study.csv" ] && [ "$(wc -l <"$tmp/stopped/study.csv")" -ge 2 ] && break
+  sleep 0.025
+done
+kill -INT "$pid"
+rc=0
+wait "$pid" || rc=$?
+[ "$rc" = 130 ] || fail "a study stopped by SIGINT exited $rc"
+grep -q "interrupted after 1 of 2 runs; they are in $tmp/stopped/study.csv" "$tmp/stopped.err" ||
+  fail "SIGINT: $(cat "$tmp/stopped.err")"
+echo "stopped by SIGINT: exit 130, the finished run kept"
+
 # --- refusals: one line, nothing written -------------------------------------------------
 s="$data/studies/rigid_motion.json"
 refuses "sweepers-cli: --voxel-sizes: no voxel size given" study "$s" -o "$tmp/bad" --voxel-sizes ""
