@@ -26,6 +26,8 @@ const char* const kColumns[] = {
     "err_rms",     "err_max",     "err_rms_voxels", "sign_flips", "order_rms",
     "err_samples", "unmatched",   "failure"};
 constexpr std::size_t kColumnCount = sizeof(kColumns) / sizeof(kColumns[0]);
+// Bounds of the whole numbers a table may hold (2^53: every integer below is a double).
+constexpr double kMaxCount = 9007199254740992.0, kMaxTopology = 2147483647.0;
 
 std::string number(double v, int digits = 7) {
     if (std::isnan(v)) return "nan";
@@ -81,6 +83,16 @@ double toNumber(const std::string& s, const std::string& where) {
     }
     if (used == 0 || used != s.size()) throw FileError(where + ": '" + s + "' is not a number");
     return v;
+}
+
+// A count or a topological number of the table: whole, and within [lo, hi] (converting a
+// damaged field such as -1, 1e300 or nan to an integer would be undefined).
+long long wholeNumber(const std::string& s, const std::string& where, double lo, double hi) {
+    const double v = toNumber(s, where);
+    if (!(v >= lo && v <= hi) || v != std::floor(v))
+        throw FileError(where + ": '" + s + "' is not a whole number from " + number(lo) + " to " +
+                        number(hi));
+    return static_cast<long long>(v);
 }
 
 double voxelsOf(const StudyRow& r) {
@@ -254,6 +266,8 @@ std::vector<StudyRow> readStudyCsv(const std::string& path) {
         StudyRow r;
         r.variant = f[0];
         r.voxelSize = toNumber(f[1], where);
+        if (!(r.voxelSize > 0.0) || !std::isfinite(r.voxelSize))
+            throw FileError(where + ": '" + f[1] + "' is not a voxel size");
         r.failure = f[22];
         if (!r.failure.empty()) {
             rows.push_back(r);
@@ -264,20 +278,20 @@ std::vector<StudyRow> readStudyCsv(const std::string& path) {
         r.renormSeconds = toNumber(f[4], where);
         r.meshSeconds = toNumber(f[5], where);
         r.peakRssMb = toNumber(f[6], where);
-        r.activeVoxels = std::size_t(toNumber(f[7], where));
+        r.activeVoxels = std::size_t(wholeNumber(f[7], where, 0, kMaxCount));
         r.volume = toNumber(f[8], where);
         r.volumeChangePct = toNumber(f[9], where);
         r.area = toNumber(f[10], where);
-        r.euler = int(toNumber(f[11], where));
-        r.genus = int(toNumber(f[12], where));
-        r.components = std::size_t(toNumber(f[13], where));
+        r.euler = int(wholeNumber(f[11], where, -kMaxTopology, kMaxTopology));
+        r.genus = int(wholeNumber(f[12], where, -kMaxTopology, kMaxTopology));
+        r.components = std::size_t(wholeNumber(f[13], where, 0, kMaxCount));
         r.error.mean = toNumber(f[14], where);
         r.error.rms = toNumber(f[15], where);
         r.error.max = toNumber(f[16], where);
-        r.error.signFlips = std::size_t(toNumber(f[18], where));
+        r.error.signFlips = std::size_t(wholeNumber(f[18], where, 0, kMaxCount));
         r.orderRms = toNumber(f[19], where);
-        r.error.samples = std::size_t(toNumber(f[20], where));
-        r.error.unmatched = std::size_t(toNumber(f[21], where));
+        r.error.samples = std::size_t(wholeNumber(f[20], where, 0, kMaxCount));
+        r.error.unmatched = std::size_t(wholeNumber(f[21], where, 0, kMaxCount));
         rows.push_back(r);
     }
     return rows;

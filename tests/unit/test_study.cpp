@@ -73,6 +73,22 @@ TEST(Study, TableReadsBackWhatWasWritten) {
     EXPECT_EQ(studyRunName(back[2]), "cubic_0.03");
     std::ofstream(path) << "not,a,study\n";
     EXPECT_THROW(readStudyCsv(path), FileError);
+    // A damaged count or voxel size is refused, not converted: the table's first row with
+    // its sign_flips (field 19) or voxel size (field 2) replaced.
+    const std::string table = studyCsv(rows);
+    const std::string header = table.substr(0, table.find('\n') + 1);
+    for (const char* bad : {"-1", "1e300", "nan", "2.5"}) {
+        std::string line =
+            table.substr(header.size(), table.find('\n', header.size()) + 1 - header.size());
+        std::size_t at = 0;
+        for (int c = 0; c < 18; ++c)
+            at = line.find(',', at) + 1;
+        line.replace(at, line.find(',', at) - at, bad);
+        std::ofstream(path) << header << line;
+        EXPECT_THROW(readStudyCsv(path), FileError) << "sign_flips " << bad;
+    }
+    std::ofstream(path) << header << "trilinear,-0.5" << std::string(21, ',') << "\n";
+    EXPECT_THROW(readStudyCsv(path), FileError) << "a negative voxel size";
     std::remove(path.c_str());
     EXPECT_TRUE(readStudyCsv(path).empty()); // no table yet: nothing to resume
 }
