@@ -15,9 +15,11 @@ ExactReference::StartFunction ExactReference::sphere(const Eigen::Vector3d& cent
 ExactReference::StartFunction ExactReference::sampled(GridPtr start) {
     if (!start) throw std::invalid_argument("ExactReference::sampled: no start grid");
     return [start](const Eigen::Vector3d& p) {
-        // One accessor per call keeps the function safe to call from several threads.
+        // One accessor per call keeps the function safe to call from several threads; the
+        // sampler keeps a reference to it.
+        const Grid::ConstAccessor acc = start->getConstAccessor();
         const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
-            start->getConstAccessor(), start->transform());
+            acc, start->transform());
         return double(sampler.wsSample(toVdb(p)));
     };
 }

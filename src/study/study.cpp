@@ -106,8 +106,9 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
         pollInterrupt(interrupter);
         Tally& t = tallies.local();
         const auto refAcc = signs->getConstAccessor();
+        const Grid::ConstAccessor acc = grid.getConstAccessor(); // the sampler keeps a reference
         const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
-            grid.getConstAccessor(), grid.transform());
+            acc, grid.transform());
         for (std::size_t l = r.begin(); l != r.end(); ++l)
             for (auto it = leaves[l]->cbeginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
