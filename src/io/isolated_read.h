@@ -19,7 +19,7 @@ namespace sweepers {
 struct ReadLimits {
     double seconds = 120.0; // wall clock for the whole read
     double bytes = 0.0;     // address space of the child; 0: 64 times the file, at least
-                            // 2 GB, at most the memory available
+                            // 512 MB, at most the memory available
 };
 
 // readLevelSetInProcess(path, gridName) (io/vdb_file.h) in a child process. Throws FileError with
