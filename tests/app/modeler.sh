@@ -11,10 +11,14 @@ py=/usr/bin/python3
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail() { echo "FAIL: $*"; exit 1; }
-run() { "$app" --size 640x480 "$@"; }
+# Under AddressSanitizer, the windowed modeler runs without the leak check: Mesa unloads its
+# driver first, so the driver's allocations can be neither named nor suppressed. The sculpt
+# controller and the command line below keep theirs.
+app_asan=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0
+run() { ASAN_OPTIONS=$app_asan "$app" --size 640x480 "$@"; }
 echo '{"events": []}' >"$tmp/none.json"
-[ "$("$app" --version)" = "sweepers $("$cli" --version | cut -d' ' -f2)" ] ||
-  fail "sweepers --version: '$("$app" --version)'"
+version=$(run --version)
+[ "$version" = "sweepers $("$cli" --version | cut -d' ' -f2)" ] || fail "sweepers --version: '$version'"
 
 # --- the default scene: a sphere in the middle -----------------------------------------
 run --hide-ui --screenshot "$tmp/default.png" --replay-input "$tmp/none.json" --save "$tmp/default.vdb"
@@ -164,7 +168,7 @@ cmp "$tmp/clean.json" "$tmp/replayed_undo.json" || fail "undo by replay: another
 # journal holds every edit (6 edits, 2 undos).
 "$py" -c 'import json,sys; e=json.load(open(sys.argv[1])); e["events"].append({"frame": 10**6, "type": "scroll", "dy": 0}); json.dump(e, open(sys.argv[2], "w"))' \
     "$here/session_drags.json" "$tmp/keepalive.json"
-"$app" --size 640x480 --replay-input "$tmp/keepalive.json" --session-dir "$tmp/sessions" \
+ASAN_OPTIONS=$app_asan "$app" --size 640x480 --replay-input "$tmp/keepalive.json" --session-dir "$tmp/sessions" \
     --checkpoint-every 2 &
 pid=$! # the modeler itself, not a shell around it
 for _ in $(seq 600); do

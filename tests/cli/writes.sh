@@ -43,15 +43,14 @@ full_disk_checks() {
   shift 2
   local limit=("$@") # a command prefix that makes writes fail
   (cd "$dir" && sha256sum ./*.vdb ./*.ply >"$tmp/sums")
-  expect_refused "$dir" "$reason" "${limit[@]}" "$cli" apply "$data/drag.json" -q \
-    -o "$dir/good.vdb"
+  expect_refused "$dir" "$reason" "${limit[@]}" "${run[@]}" -o "$dir/good.vdb"
   expect_refused "$dir" "$reason" "${limit[@]}" "$cli" mesh "$tmp/big.vdb" -o "$dir/good.ply"
-  expect_refused "$dir" "$reason" "${limit[@]}" "$cli" apply "$data/drag.json" -q \
-    -o "$dir/new.vdb" --mesh "$dir/new.ply"
+  expect_refused "$dir" "$reason" "${limit[@]}" "${run[@]}" -o "$dir/new.vdb" --mesh "$dir/new.ply"
   [ ! -e "$dir/new.vdb" ] || fail "apply --mesh left a grid behind when its mesh failed"
 }
 
 "$cli" new -o "$tmp/big.vdb" --voxel-size 0.01 # about 3 MB, and a mesh of about 5 MB
+run=("$cli" apply "$data/pull.json" -q --voxel-size 0.01) # 4 MB written (0.6 s, 3 s under ASan)
 
 # --- a file-size limit: every write past 256 KiB fails (EFBIG) -------------------------
 mkdir "$tmp/limited"
@@ -74,17 +73,21 @@ mkdir "$tmp/killed"
 out=$tmp/killed/out.vdb
 "$cli" new -o "$tmp/old.vdb" --voxel-size 0.1
 old=$("$cli" info "$tmp/old.vdb" | grep -o '[0-9]* active voxels')
-run=("$cli" apply "$data/pull.json" -q --voxel-size 0.01) # about 0.6 s, 4 MB written
+# The kills fall anywhere in the run, its write included, however fast this build is: at
+# moments spread over 0 to 1.1 times the run's own time (in microseconds).
+start=${EPOCHREALTIME/./}
 "${run[@]}" -o "$tmp/new.vdb"
+took=$((${EPOCHREALTIME/./} - start))
 new=$("$cli" info "$tmp/new.vdb" | grep -o '[0-9]* active voxels')
-RANDOM=11 # the same moments every run
+RANDOM=11 # the same fractions every run
 olds=0
 news=0
-for i in $(seq 20); do
+for i in $(seq 16); do
   cp "$tmp/old.vdb" "$out"
   "${run[@]}" -o "$out" &
   pid=$!
-  sleep "0.$(printf '%03d' $((RANDOM % 800)))"
+  delay=$((took * (RANDOM % 1100) / 1000))
+  sleep "$((delay / 1000000)).$(printf '%06d' $((delay % 1000000)))"
   kill -9 "$pid" 2>/dev/null || true
   wait "$pid" 2>/dev/null || true
   now=$("$cli" info "$out" | grep -o '[0-9]* active voxels') || fail "kill $i: $out is unreadable"
