@@ -332,24 +332,29 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         stats.leavesCopied += moving.size();
         return copy;
     };
+    // Voxels inside the region that are not in the band kept their old inactive values,
+    // whose signs may now be wrong (space pulled out of the shape is inside it now):
+    // re-derive the inactive signs there (and in the band grown around it) from the band.
+    const openvdb::CoordBBox touched = changedRegion(grid, seg);
     if (!options.resampleEachSubStep) {
         stats.sampledVoxels = resample(
             grid, moving, *source(0), !widened, region,
             [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); }, options.sampling, *changed,
             options.interrupter);
     } else {
-        for (int k = 0; k < seg.steps(); ++k)
+        // Each sub-step reads what the one before wrote, inactive values included, so their
+        // signs are re-derived before it reads them: otherwise a pre-image beyond the band
+        // takes the sign its place had before the earlier sub-steps moved the surface.
+        for (int k = 0; k < seg.steps(); ++k) {
+            if (k > 0) stats.leavesFlooded += floodSignsIn(grid.tree(), touched);
             stats.sampledVoxels += resample(
                 grid, moving, *source(k), !widened || k > 0, region,
                 [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling,
                 *changed, options.interrupter);
+        }
     }
     stats.voxelsVisited += stats.sampledVoxels;
-    // Voxels inside the region that are not in the band kept their old inactive values,
-    // whose signs may now be wrong (space pulled out of the shape is inside it now):
-    // re-derive the inactive signs there (and in the band grown around it) from the band.
-    const openvdb::CoordBBox touched = changedRegion(grid, seg);
-    stats.leavesFlooded = floodSignsIn(grid.tree(), touched);
+    stats.leavesFlooded += floodSignsIn(grid.tree(), touched);
     stats.sampleSeconds = secondsSince(t0);
 
     // 3. Renormalize the changed region (and the band around it).

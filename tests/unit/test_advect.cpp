@@ -108,6 +108,27 @@ TEST(Advect, ComposedInverseBeatsResamplingEachSubStep) {
     EXPECT_LT(a, b);
 }
 
+// Two sub-steps of 0.25 each, 33 voxels, ten times the band: the second reads, beyond the
+// band, space the first moved the sphere out of. With the inside signs that space had
+// before, it grew 12 stray pieces of surface there.
+TEST(Advect, ResamplingEachSubStepReadsTheSignsTheSubStepBeforeLeft) {
+    const double h = 1.0 / 128;
+    const Eigen::Vector3d d(0.5, 0.1, 0.0);
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 0.3, h, 3);
+    Sweep sweep{{{std::make_shared<EllipsoidShape>(0.45), 0.6, {at({0, 0, 0}), at(d)}}}};
+    const SweepSegment seg(sweep, 0);
+    ASSERT_EQ(seg.steps(), 2);
+    AdvectOptions o;
+    o.resampleEachSubStep = true;
+    advectSegment(*g, seg, o);
+    const LevelSetMeasures m = measureLevelSet(*g);
+    EXPECT_EQ(m.components, 1u);
+    EXPECT_EQ(m.genus, 0);
+    const Eigen::Vector3d c = centroid(meshLevelSet(*g));
+    EXPECT_LT((c - d).norm(), 0.5 * h);
+    EXPECT_NEAR(m.volume, 4.0 / 3.0 * M_PI * 0.027, 0.01 * 4.0 / 3.0 * M_PI * 0.027);
+}
+
 TEST(Advect, MonotoneCubicNeverOvershoots) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(-1, 1);
