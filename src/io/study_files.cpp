@@ -8,6 +8,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <string_view>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,12 +21,20 @@ namespace sweepers {
 namespace {
 
 const char* const kColumns[] = {
-    "variant",     "voxel_size",  "wall_s",         "advect_s",   "renorm_s",
-    "mesh_s",      "peak_rss_mb", "active_voxels",  "volume",     "volume_change_pct",
-    "area",        "euler",       "genus",          "components", "err_mean",
-    "err_rms",     "err_max",     "err_rms_voxels", "sign_flips", "order_rms",
-    "err_samples", "unmatched",   "failure"};
+    "variant",        "voxel_size",  "wall_s",         "advect_s",   "renorm_s",
+    "mesh_s",         "peak_rss_mb", "active_voxels",  "volume",     "volume_change_pct",
+    "area",           "euler",       "genus",          "components", "err_mean",
+    "err_rms",        "err_max",     "err_rms_voxels", "sign_flips", "order_rms",
+    "volume_ref",     "volume_err",  "order_volume",   "ref_euler",  "ref_genus",
+    "ref_components", "err_samples", "unmatched",      "failure"};
 constexpr std::size_t kColumnCount = sizeof(kColumns) / sizeof(kColumns[0]);
+// The position of a column in kColumns.
+constexpr std::size_t column(std::string_view name) {
+    std::size_t c = 0;
+    while (c < kColumnCount && kColumns[c] != name)
+        ++c;
+    return c;
+}
 // Bounds of the whole numbers a table may hold (2^53: every integer below is a double).
 constexpr double kMaxCount = 9007199254740992.0, kMaxTopology = 2147483647.0;
 
@@ -242,8 +251,11 @@ std::string studyCsv(const std::vector<StudyRow>& rows) {
             << integer(r.euler) << "," << integer(r.genus) << "," << count(r.components) << ","
             << num(r.error.mean) << "," << num(r.error.rms) << "," << num(r.error.max) << ","
             << num(voxelsOf(r)) << "," << count(r.error.signFlips) << "," << num(r.orderRms, 4)
-            << "," << count(r.error.samples) << "," << count(r.error.unmatched) << ","
-            << field(r.failure) << "\n";
+            << "," << num(r.error.referenceVolume, 12) << "," << num(r.error.volumeError(), 7)
+            << "," << num(r.orderVolume, 4) << "," << integer(r.referenceEuler) << ","
+            << integer(r.referenceGenus) << "," << count(r.referenceComponents) << ","
+            << count(r.error.samples) << "," << count(r.error.unmatched) << "," << field(r.failure)
+            << "\n";
     }
     return out.str();
 }
@@ -252,9 +264,12 @@ std::vector<StudyRow> readStudyCsv(const std::string& path) {
     std::ifstream in(path);
     if (!in) return {};
     std::string line;
-    if (!std::getline(in, line) || splitCsvLine(line).size() != kColumnCount ||
+    if (!std::getline(in, line) || splitCsvLine(line).empty() ||
         splitCsvLine(line)[0] != kColumns[0])
         throw FileError(path + ": not a study table (its first line is not the header)");
+    if (splitCsvLine(line) != std::vector<std::string>(kColumns, kColumns + kColumnCount))
+        throw FileError(path + ": a study table with other columns (of another version of "
+                               "sweepers-cli); --force starts the study again");
     std::vector<StudyRow> rows;
     for (int n = 2; std::getline(in, line); ++n) {
         if (line.empty()) continue;
@@ -263,41 +278,63 @@ std::vector<StudyRow> readStudyCsv(const std::string& path) {
         if (f.size() != kColumnCount)
             throw FileError(where + ": " + std::to_string(f.size()) + " fields, not " +
                             std::to_string(kColumnCount));
+        const auto at = [&](std::string_view name) -> const std::string& {
+            return f[column(name)];
+        };
+        const auto real = [&](std::string_view name) { return toNumber(at(name), where); };
+        const auto whole = [&](std::string_view name, double lo, double hi) {
+            return wholeNumber(at(name), where, lo, hi);
+        };
         StudyRow r;
-        r.variant = f[0];
-        r.voxelSize = toNumber(f[1], where);
+        r.variant = at("variant");
+        r.voxelSize = real("voxel_size");
         if (!(r.voxelSize > 0.0) || !std::isfinite(r.voxelSize))
-            throw FileError(where + ": '" + f[1] + "' is not a voxel size");
-        r.failure = f[22];
+            throw FileError(where + ": '" + at("voxel_size") + "' is not a voxel size");
+        r.failure = at("failure");
         if (!r.failure.empty()) {
             rows.push_back(r);
             continue;
         }
-        r.wallSeconds = toNumber(f[2], where);
-        r.advectSeconds = toNumber(f[3], where);
-        r.renormSeconds = toNumber(f[4], where);
-        r.meshSeconds = toNumber(f[5], where);
-        r.peakRssMb = toNumber(f[6], where);
-        r.activeVoxels = std::size_t(wholeNumber(f[7], where, 0, kMaxCount));
-        r.volume = toNumber(f[8], where);
-        r.volumeChangePct = toNumber(f[9], where);
-        r.area = toNumber(f[10], where);
-        r.euler = int(wholeNumber(f[11], where, -kMaxTopology, kMaxTopology));
-        r.genus = int(wholeNumber(f[12], where, -kMaxTopology, kMaxTopology));
-        r.components = std::size_t(wholeNumber(f[13], where, 0, kMaxCount));
-        r.error.mean = toNumber(f[14], where);
-        r.error.rms = toNumber(f[15], where);
-        r.error.max = toNumber(f[16], where);
-        r.error.signFlips = std::size_t(wholeNumber(f[18], where, 0, kMaxCount));
-        r.orderRms = toNumber(f[19], where);
-        r.error.samples = std::size_t(wholeNumber(f[20], where, 0, kMaxCount));
-        r.error.unmatched = std::size_t(wholeNumber(f[21], where, 0, kMaxCount));
+        r.wallSeconds = real("wall_s");
+        r.advectSeconds = real("advect_s");
+        r.renormSeconds = real("renorm_s");
+        r.meshSeconds = real("mesh_s");
+        r.peakRssMb = real("peak_rss_mb");
+        r.activeVoxels = std::size_t(whole("active_voxels", 0, kMaxCount));
+        r.volume = real("volume");
+        r.volumeChangePct = real("volume_change_pct");
+        r.area = real("area");
+        r.euler = int(whole("euler", -kMaxTopology, kMaxTopology));
+        r.genus = int(whole("genus", -kMaxTopology, kMaxTopology));
+        r.components = std::size_t(whole("components", 0, kMaxCount));
+        r.error.mean = real("err_mean");
+        r.error.rms = real("err_rms");
+        r.error.max = real("err_max");
+        r.error.signFlips = std::size_t(whole("sign_flips", 0, kMaxCount));
+        r.orderRms = real("order_rms");
+        r.error.referenceVolume = real("volume_ref");
+        r.error.meshVolume = r.error.referenceVolume + real("volume_err");
+        r.orderVolume = real("order_volume");
+        r.referenceEuler = int(whole("ref_euler", -kMaxTopology, kMaxTopology));
+        r.referenceGenus = int(whole("ref_genus", -kMaxTopology, kMaxTopology));
+        r.referenceComponents = std::size_t(whole("ref_components", 0, kMaxCount));
+        r.error.samples = std::size_t(whole("err_samples", 0, kMaxCount));
+        r.error.unmatched = std::size_t(whole("unmatched", 0, kMaxCount));
         rows.push_back(r);
     }
     return rows;
 }
 
 std::string studyReport(const std::vector<StudyRow>& rows, const std::string& script) {
+    const auto changed = [](const StudyRow& r) {
+        return r.euler != r.referenceEuler || r.genus != r.referenceGenus ||
+               r.components != r.referenceComponents;
+    };
+    const auto topology = [](const StudyRow& r) {
+        return "Euler " + std::to_string(r.referenceEuler) + ", genus " +
+               std::to_string(r.referenceGenus) + ", " + std::to_string(r.referenceComponents) +
+               (r.referenceComponents == 1 ? " component" : " components");
+    };
     std::ostringstream out;
     out << "# Grid-resolution study of " << script << "\n\n"
         << "Errors are distances between the result's surface and the exact surface that the "
@@ -305,21 +342,31 @@ std::string studyReport(const std::vector<StudyRow>& rows, const std::string& sc
            "their normals, exact crossings on voxel edges to the grid's surface); sign flips "
            "are active voxels on the wrong side of the exact surface. The order p compares "
            "each run with the next coarser one of its variant: "
-           "p = log(e_coarse / e_fine) / log(h_coarse / h_fine).\n\n"
+           "p = log(e_coarse / e_fine) / log(h_coarse / h_fine). The volume error is the signed "
+           "volume between the result's mesh and the same mesh with every vertex moved to the "
+           "exact surface, in percent of the latter (the exact volume on the result's "
+           "tessellation); its order is that of its size. The exact shape keeps the start's "
+           "topology, since every sub-step is a fold-over-free deformation of space; where a "
+           "run's topology differs, the grid lost a feature thinner than it resolves, and "
+           "its components column gives the exact topology.\n\n"
         << "| variant | voxel size | err RMS (voxels) | err max (voxels) | err RMS | order (RMS) "
-           "| sign flips | volume change | Euler | genus | components | time (s) |\n"
-        << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+           "| sign flips | volume error | order (volume) | volume change | Euler | genus "
+           "| components | time (s) |\n"
+        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const StudyRow& r : rows) {
         out << "| " << r.variant << " | 1/" << number(1.0 / r.voxelSize, 6) << " | ";
         if (!r.failure.empty()) {
-            out << "failed: " << r.failure << " | | | | | | | | | |\n";
+            out << "failed: " << r.failure << " | | | | | | | | | | | |\n";
             continue;
         }
         out << number(voxelsOf(r), 3) << " | " << number(r.error.max / r.voxelSize, 3) << " | "
             << number(r.error.rms, 3) << " | "
             << (std::isnan(r.orderRms) ? "" : number(r.orderRms, 3)) << " | " << r.error.signFlips
-            << " | " << number(r.volumeChangePct, 3) << "% | " << r.euler << " | " << r.genus
-            << " | " << r.components << " | " << number(r.wallSeconds, 3) << " |\n";
+            << " | " << number(100.0 * r.error.volumeError() / r.error.referenceVolume, 3) << "% | "
+            << (std::isnan(r.orderVolume) ? "" : number(r.orderVolume, 3)) << " | "
+            << number(r.volumeChangePct, 3) << "% | " << r.euler << " | " << r.genus << " | "
+            << r.components << (changed(r) ? " (exact: " + topology(r) + ")" : "") << " | "
+            << number(r.wallSeconds, 3) << " |\n";
     }
     return out.str();
 }

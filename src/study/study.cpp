@@ -126,6 +126,7 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
     });
 
     // Mesh to reference: the nearest bracket along the normal that holds a crossing.
+    std::vector<Eigen::Vector3d> onReference(mesh.positions.size());
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, mesh.positions.size(), 256), [&](const auto& r) {
             pollInterrupt(interrupter);
@@ -138,6 +139,7 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
                 std::optional<Eigen::Vector3d> c;
                 for (int reach = 1; reach <= int(InterfaceError::kSearchVoxels) && !c; ++reach)
                     c = reference.crossing(p - reach * h * n, p + reach * h * n, tolerance);
+                onReference[i] = c ? *c : p;
                 if (c) {
                     t.add((*c - p).norm());
                 } else {
@@ -151,6 +153,20 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
     for (const Tally& t : tallies)
         all.merge(t);
     InterfaceError e;
+    // Volumes by the divergence theorem, a tetrahedron from the origin per triangle; the
+    // mesh's orientation gives both the same sign.
+    for (const Eigen::Vector3i& tri : mesh.triangles) {
+        const auto at = [&](int k) { return mesh.positions[std::size_t(tri[k])].cast<double>(); };
+        e.meshVolume += at(0).dot(at(1).cross(at(2))) / 6.0;
+        e.referenceVolume +=
+            onReference[std::size_t(tri[0])].dot(
+                onReference[std::size_t(tri[1])].cross(onReference[std::size_t(tri[2])])) /
+            6.0;
+    }
+    if (e.meshVolume < 0.0) {
+        e.meshVolume = -e.meshVolume;
+        e.referenceVolume = -e.referenceVolume;
+    }
     e.samples = all.count;
     e.unmatched = all.unmatched;
     e.signFlips = all.flips;
@@ -169,7 +185,10 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
     StudyRow& row = run.row;
     row.variant = variantName(variant);
     row.voxelSize = start->voxelSize()[0];
-    const double startVolume = measureLevelSet(*start).volume;
+    const LevelSetMeasures before = measureLevelSet(*start);
+    row.referenceEuler = before.eulerCharacteristic;
+    row.referenceGenus = before.genus;
+    row.referenceComponents = before.components;
 
     AdvectOptions options = variantOptions(variant);
     options.interrupter = interrupter;
@@ -197,7 +216,7 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
     const LevelSetMeasures m = measureLevelSet(*run.grid);
     row.activeVoxels = m.activeVoxels;
     row.volume = m.volume;
-    row.volumeChangePct = 100.0 * (m.volume - startVolume) / startVolume;
+    row.volumeChangePct = 100.0 * (m.volume - before.volume) / before.volume;
     row.area = m.area;
     row.euler = m.eulerCharacteristic;
     row.genus = m.genus;
@@ -209,18 +228,26 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
 void fillOrders(std::vector<StudyRow>& rows) {
     std::map<std::string, std::vector<StudyRow*>> byVariant;
     for (StudyRow& r : rows) {
-        r.orderRms = std::numeric_limits<double>::quiet_NaN();
+        r.orderRms = r.orderVolume = std::numeric_limits<double>::quiet_NaN();
         if (r.failure.empty()) byVariant[r.variant].push_back(&r);
     }
+    // p = log(e_coarse / e_fine) / log(h_coarse / h_fine)
+    const auto order = [](double coarseError, double fineError, double coarseH, double fineH) {
+        if (!(coarseError > 0.0 && fineError > 0.0 && coarseH > fineH))
+            return std::numeric_limits<double>::quiet_NaN();
+        return std::log(coarseError / fineError) / std::log(coarseH / fineH);
+    };
     for (auto& [name, runs] : byVariant) {
         std::sort(runs.begin(), runs.end(),
                   [](const StudyRow* a, const StudyRow* b) { return a->voxelSize > b->voxelSize; });
         for (std::size_t k = 1; k < runs.size(); ++k) {
             const StudyRow& coarse = *runs[k - 1];
             StudyRow& fine = *runs[k];
-            if (coarse.error.rms > 0.0 && fine.error.rms > 0.0 && coarse.voxelSize > fine.voxelSize)
-                fine.orderRms = std::log(coarse.error.rms / fine.error.rms) /
-                                std::log(coarse.voxelSize / fine.voxelSize);
+            fine.orderRms =
+                order(coarse.error.rms, fine.error.rms, coarse.voxelSize, fine.voxelSize);
+            fine.orderVolume =
+                order(std::abs(coarse.error.volumeError()), std::abs(fine.error.volumeError()),
+                      coarse.voxelSize, fine.voxelSize);
         }
     }
 }

@@ -37,6 +37,12 @@ struct InterfaceError {
     // counted at that distance (a lower bound of their error).
     std::size_t unmatched = 0;
     std::size_t signFlips = 0; // active voxels on the other side of the reference surface
+    // The volume inside the result's mesh, and inside the same mesh with every vertex moved
+    // to its reference crossing (unmatched vertices stay): the reference's volume on the
+    // result's own tessellation. Their difference is the signed volume between the two
+    // surfaces, in which the tessellation's error of the shape cancels.
+    double meshVolume = 0.0, referenceVolume = 0.0;
+    double volumeError() const { return meshVolume - referenceVolume; }
     static constexpr double kSearchVoxels = 3.0;
 };
 InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
@@ -51,10 +57,17 @@ struct StudyRow {
     double volume = 0.0, volumeChangePct = 0.0, area = 0.0;
     int euler = 0, genus = 0;
     std::size_t components = 0;
+    // The exact shape's topology: the start's, since every sub-step is a fold-over-free
+    // diffeomorphism of space (measured on the start grid). Where the result's differs, the
+    // grid changed the topology (a feature thinner than it resolves).
+    int referenceEuler = 0, referenceGenus = 0;
+    std::size_t referenceComponents = 0;
     InterfaceError error;
     // Observed order of the RMS error against the next coarser run of the same variant
     // (NaN for the coarsest): p = log(e_coarse / e_fine) / log(h_coarse / h_fine).
     double orderRms = std::numeric_limits<double>::quiet_NaN();
+    // The same for the size of the volume error, |error.volumeError()|.
+    double orderVolume = std::numeric_limits<double>::quiet_NaN();
     std::string failure; // why the run failed; empty when it ran
 };
 
@@ -72,8 +85,8 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
                       const ExactReference::StartFunction& startShape, StudyVariant variant,
                       Interrupter* interrupter = nullptr, const Progress& progress = {});
 
-// Fills orderRms of every row from the next coarser row of its variant (failed rows and
-// rows without a coarser one get NaN).
+// Fills orderRms and orderVolume of every row from the next coarser row of its variant
+// (failed rows and rows without a coarser one get NaN).
 void fillOrders(std::vector<StudyRow>& rows);
 
 } // namespace sweepers
