@@ -218,7 +218,7 @@ void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir,
        << series(3) << "\n"
        << "set logscale y\nset ylabel 'seconds'\nset title 'time'\n"
        << series(4) << "\n"
-       << "set ylabel 'MB'\nset title 'peak memory (of the process so far)'\n"
+       << "set ylabel 'MB'\nset title 'peak resident memory during each run'\n"
        << series(5) << "\n"
        << "unset multiplot\n";
     writeTextAtomically(dir + "/convergence.gp", gp.str());

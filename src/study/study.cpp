@@ -5,11 +5,11 @@
 #include <map>
 
 #include <openvdb/tools/Interpolation.h>
-#include <sys/resource.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "core/memory.h"
 #include "core/stopwatch.h"
 #include "levelset/measure.h"
 #include "mesh/marching_cubes.h"
@@ -36,12 +36,6 @@ struct Tally {
         flips += o.flips;
     }
 };
-
-double peakRssMb() {
-    rusage usage{};
-    getrusage(RUSAGE_SELF, &usage);
-    return double(usage.ru_maxrss) / 1024.0; // ru_maxrss is in kilobytes on Linux
-}
 
 } // namespace
 
@@ -181,6 +175,9 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
 StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
                       const ExactReference::StartFunction& startShape, StudyVariant variant,
                       Interrupter* interrupter, const Progress& progress) {
+    // The run's own peak memory, not the process's: a finer run before it (or a variant
+    // that needs more at the same size) would hide it.
+    restartPeakResident();
     StudyRun run;
     StudyRow& row = run.row;
     row.variant = variantName(variant);
@@ -210,7 +207,7 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
     run.mesh = mesher.weld();
     row.meshSeconds = secondsSince(t1);
     row.wallSeconds = secondsSince(t0);
-    row.peakRssMb = peakRssMb();
+    row.peakRssMb = peakResidentBytes() / double(1 << 20);
 
     run.grid = sculptor.gridPtr();
     const LevelSetMeasures m = measureLevelSet(*run.grid);

@@ -52,7 +52,9 @@ struct StudyRow {
     std::string variant;
     double voxelSize = 0.0;
     double wallSeconds = 0.0, advectSeconds = 0.0, renormSeconds = 0.0, meshSeconds = 0.0;
-    double peakRssMb = 0.0; // the process's peak so far (runs go from coarse to fine)
+    // Peak resident memory during the run, its start grid included (the process's peak so
+    // far where the kernel cannot restart the count).
+    double peakRssMb = 0.0;
     std::size_t activeVoxels = 0;
     double volume = 0.0, volumeChangePct = 0.0, area = 0.0;
     int euler = 0, genus = 0;
