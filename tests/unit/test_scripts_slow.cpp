@@ -73,7 +73,9 @@ TEST(DataScripts, EveryScriptInDataIsCovered) {
 }
 
 TEST(Advect, PinchOpensAHole) {
-    // At the script's voxel size only: the squeeze is one voxel thin there on purpose.
+    // At the script's voxel size only: the squeeze is one voxel thin there on purpose. The
+    // hole is the grid's, not the deformation's (a sweep cannot tear space): the exact shape
+    // stays a sphere, and from 1/256 on the grid holds the membrane (sweepers-cli study).
     const StrokeScript script = readStrokeScript(dataPath("pinch"));
     Sculptor sculptor(makeStartGrid(script, SWEEPERS_DATA_DIR));
     const GridPtr g = sculptor.gridPtr();
