@@ -29,7 +29,7 @@ const char* const kColumns[] = {
     "ref_components", "err_samples", "unmatched",      "failure"};
 constexpr std::size_t kColumnCount = sizeof(kColumns) / sizeof(kColumns[0]);
 // The position of a column in kColumns.
-constexpr std::size_t column(std::string_view name) {
+std::size_t column(std::string_view name) {
     std::size_t c = 0;
     while (c < kColumnCount && kColumns[c] != name)
         ++c;
