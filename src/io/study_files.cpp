@@ -164,7 +164,8 @@ std::string runGnuplot(const std::string& dir, const std::string& script,
 void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir,
                      const std::string& script) {
     // One data block per variant (gnuplot breaks a line at every row it skips, and the table
-    // interleaves the variants): voxel size, RMS error, volume change, time, peak memory.
+    // interleaves the variants): voxel size, RMS error, volume error (percent of the exact
+    // volume), time, peak memory.
     std::vector<std::string> variants;
     std::set<double> sizes;
     std::ostringstream blocks;
@@ -180,8 +181,8 @@ void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir,
             if (!first) first = &r;
             sizes.insert(r.voxelSize);
             blocks << number(r.voxelSize, 17) << " " << number(r.error.rms) << " "
-                   << number(r.volumeChangePct) << " " << number(r.wallSeconds) << " "
-                   << number(r.peakRssMb) << "\n";
+                   << number(100.0 * r.error.volumeError() / r.error.referenceVolume) << " "
+                   << number(r.wallSeconds) << " " << number(r.peakRssMb) << "\n";
         }
         blocks << "EOD\n";
     }
@@ -213,10 +214,10 @@ void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir,
        << series(2) << ", " << number(e0 / h0, 17) << " * x dashtype 2 linecolor 'gray' "
        << "title 'slope 1', " << number(e0 / (h0 * h0), 17)
        << " * x**2 dashtype 3 linecolor 'black' title 'slope 2'\n"
-       << "unset key\nunset logscale y\nset ylabel 'volume change (%)'\n"
-       << "set title 'volume drift'\n"
+       << "unset key\nunset logscale y\nset ylabel 'volume error (%)'\n"
+       << "set title 'volume drift from the exact shape'\nset xzeroaxis\n"
        << series(3) << "\n"
-       << "set logscale y\nset ylabel 'seconds'\nset title 'time'\n"
+       << "unset xzeroaxis\nset logscale y\nset ylabel 'seconds'\nset title 'time'\n"
        << series(4) << "\n"
        << "set ylabel 'MB'\nset title 'peak resident memory during each run'\n"
        << series(5) << "\n"

@@ -78,6 +78,21 @@ print(f"translated sphere at 1/64: study volume_err {study:.3g}, against the ana
 assert abs(float(rows[2]["volume_ref"]) - exact) < 1e-6 * exact, (rows[2]["volume_ref"], exact)
 assert abs(study - independent) < 0.05 * abs(independent), (study, independent)
 PY
+# The plots draw the table's figures: the first data block (trilinear) holds each run's
+# voxel size, RMS error and volume error in percent of the exact volume.
+"$py" - "$tmp/t" <<'PY'
+import csv, sys
+d = sys.argv[1]
+rows = [r for r in csv.DictReader(open(f"{d}/study.csv")) if r["variant"] == "trilinear"]
+gp = open(f"{d}/convergence.gp").read()
+block = gp.split("$v0 << EOD\n", 1)[1].split("EOD\n", 1)[0].split("\n")[:-1]
+assert len(block) == len(rows), (block, rows)
+for line, r in zip(block, rows):
+    h, rms, volume = map(float, line.split()[:3])
+    percent = 100 * float(r["volume_err"]) / float(r["volume_ref"])
+    assert h == float(r["voxel_size"]) and rms == float(r["err_rms"]), (line, r)
+    assert abs(volume - percent) < 1e-5 * abs(percent), (line, percent)
+PY
 for f in study.csv report.md convergence.gp convergence.png convergence.svg; do
   [ -s "$tmp/t/$f" ] || fail "the study of two sizes and two variants wrote no $f"
 done
