@@ -19,6 +19,7 @@
 #include <unistd.h>
 
 #include <openvdb/io/Stream.h>
+#include <tbb/global_control.h>
 
 #include "core/format.h"
 #include "core/memory.h"
@@ -67,6 +68,9 @@ bool serveReadIfAsked() {
     for (std::string arg; std::getline(cmdline, arg, '\0');)
         args.push_back(arg);
     if (args.size() != 4 || args[1] != kMarker) return false;
+    // One thread: its memory limit holds the reader's work, not a stack and a malloc arena
+    // for each of the machine's cores (64 MB of address space each).
+    const tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
     try {
         const LevelSetFile file = readLevelSetInProcess(args[2], args[3]);
         std::ostringstream out;
@@ -129,9 +133,12 @@ LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gri
     // The child's environment: the parent's, and under AddressSanitizer a resident-memory
     // limit in its options (without one, a damaged file that makes the reader allocate
     // gigabytes took 30 s there, where the address-space limit stops it in 3).
-    std::vector<std::string> env;
+    // Threads the libraries start themselves still get an arena each unless glibc is told.
+    std::vector<std::string> env{"MALLOC_ARENA_MAX=1"};
     for (char** e = environ; *e; ++e)
-        if (!kAddressSanitizer || std::strncmp(*e, "ASAN_OPTIONS=", 13) != 0) env.emplace_back(*e);
+        if ((!kAddressSanitizer || std::strncmp(*e, "ASAN_OPTIONS=", 13) != 0) &&
+            std::strncmp(*e, "MALLOC_ARENA_MAX=", 17) != 0)
+            env.emplace_back(*e);
     if (kAddressSanitizer && bytes > 0) {
         const char* options = std::getenv("ASAN_OPTIONS");
         env.push_back(std::string("ASAN_OPTIONS=") + (options ? options : "") +
