@@ -6,22 +6,27 @@
 
 namespace sweepers {
 
-double availableMemoryBytes() {
-    std::ifstream info("/proc/meminfo");
+namespace {
+
+// The figure of the line "<key>: <n> kB" of a /proc file, in bytes; 0 when there is none.
+double kilobytesLine(const char* path, const char* key) {
+    std::ifstream file(path);
+    const std::string format = std::string(key) + ": %lf kB";
     std::string line;
     double kib = 0.0;
-    while (std::getline(info, line))
-        if (std::sscanf(line.c_str(), "MemAvailable: %lf kB", &kib) == 1) return kib * 1024.0;
+    while (std::getline(file, line))
+        if (std::sscanf(line.c_str(), format.c_str(), &kib) == 1) return kib * 1024.0;
     return 0.0;
 }
 
+} // namespace
+
+double availableMemoryBytes() {
+    return kilobytesLine("/proc/meminfo", "MemAvailable");
+}
+
 double peakResidentBytes() {
-    std::ifstream status("/proc/self/status");
-    std::string line;
-    double kib = 0.0;
-    while (std::getline(status, line))
-        if (std::sscanf(line.c_str(), "VmHWM: %lf kB", &kib) == 1) return kib * 1024.0;
-    return 0.0;
+    return kilobytesLine("/proc/self/status", "VmHWM");
 }
 
 bool restartPeakResident() {

@@ -121,6 +121,8 @@ std::string quoted(const std::string& s) {
 // standard output).
 std::string runGnuplot(const std::string& dir, const std::string& script,
                        const std::string& terminal) {
+    // Built before the fork: the child of a threaded process may not allocate.
+    const std::string set = "set terminal " + terminal;
     int out[2];
     if (::pipe(out) != 0) throw std::runtime_error("plots: cannot start gnuplot (pipe)");
     const pid_t pid = ::fork();
@@ -134,19 +136,21 @@ std::string runGnuplot(const std::string& dir, const std::string& script,
         ::close(out[0]);
         ::close(out[1]);
         if (::chdir(dir.c_str()) != 0) ::_exit(126);
-        const std::string set = "set terminal " + terminal;
         ::execlp("gnuplot", "gnuplot", "-e", set.c_str(), script.c_str(), (char*)nullptr);
         ::_exit(errno == ENOENT ? 127 : 126);
     }
     ::close(out[1]);
     std::string image;
     char buf[65536];
+    bool readFailed = false;
     for (;;) {
         const ssize_t n = ::read(out[0], buf, sizeof buf);
-        if (n > 0)
+        if (n > 0) {
             image.append(buf, std::size_t(n));
-        else if (n == 0 || errno != EINTR)
+        } else if (n == 0 || errno != EINTR) {
+            readFailed = n < 0; // a part of the image is not a plot
             break;
+        }
     }
     ::close(out[0]);
     int status = 0;
@@ -154,7 +158,7 @@ std::string runGnuplot(const std::string& dir, const std::string& script,
     }
     if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
         throw std::runtime_error("plots: gnuplot is not installed (Debian: gnuplot-nox)");
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || image.empty())
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || image.empty() || readFailed)
         throw std::runtime_error("plots: gnuplot failed on " + dir + "/" + script);
     return image;
 }

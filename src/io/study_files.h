@@ -20,7 +20,8 @@ std::string studyReport(const std::vector<StudyRow>& rows, const std::string& sc
 
 // DIR/convergence.gp, and from it DIR/convergence.png and DIR/convergence.svg drawn by
 // gnuplot: the RMS error against the voxel size per variant (log-log, with slope-1 and
-// slope-2 guides), the volume change, the time and the peak memory against the voxel size.
+// slope-2 guides), the volume error against the exact shape, the time and each run's peak
+// memory against the voxel size.
 // Each file is written atomically. Throws std::runtime_error when gnuplot cannot draw them
 // (for example when it is not installed).
 void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir,
