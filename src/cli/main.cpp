@@ -80,8 +80,27 @@ int runCheck(const std::string& path, bool asJson) {
                  {"steps", seg.steps()},
                  {"bound", 0.0},
                  {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
-        } else {
+        } else if (std::holds_alternative<InflateStroke>(script.strokes[i])) {
             out.push_back({{"stroke", i}, {"type", "inflate"}});
+        } else {
+            // A pinch or a strangle: its sub-steps depend on the voxel size (the script's).
+            const auto* pinch = std::get_if<PinchStroke>(&script.strokes[i]);
+            const double h = script.grid.voxelSize;
+            const auto parts = pinch ? planPinch(*pinch, h)
+                                     : planStrangle(std::get<StrangleStroke>(script.strokes[i]), h);
+            for (std::size_t k = 0; k < parts.size(); ++k) {
+                const StepDeformation& seg = *parts[k];
+                out.push_back(
+                    {{"stroke", i},
+                     {"type", std::string(pinch ? "pinch" : "strangle") + (seg.tears() ? " pull"
+                                                                           : pinch     ? " needles"
+                                                                                       : " noose")},
+                     {"segment", k},
+                     {"tools", 1},
+                     {"steps", seg.steps()},
+                     {"bound", 0.0},
+                     {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
+            }
         }
     }
     if (asJson) {

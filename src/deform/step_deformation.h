@@ -5,6 +5,7 @@
 // (INVERTFASTER, 5.4.1), are shared here.
 #pragma once
 
+#include <limits>
 #include <optional>
 
 #include "core/box.h"
@@ -44,6 +45,23 @@ class StepDeformation {
     // Whole forward map: forward sub-steps 0 up to s-1.
     ForwardResult forwardMap(const Eigen::Vector3d& p) const;
 
+    // Whether the deformation tears space open (tear.h; such a deformation has one sub-step):
+    // then inverseMap gives a point with no pre-image the torn point it came from, and
+    // openedDepth how deep it lies inside the opened region, which the value sampled there
+    // gains (its positive part). openedDepth is signed: beyond the opening's rim, minus the
+    // distance to it; -infinity for a deformation that does not tear.
+    bool tears() const { return tears_; }
+    virtual double openedDepth(const Eigen::Vector3d& /*x*/) const {
+        return -std::numeric_limits<double>::infinity();
+    }
+    // A box holding every point whose openedDepth is positive (empty when nothing tears).
+    virtual Box openedBox() const { return {}; }
+    // A unit direction along the torn set at the point x was torn from (zero when nothing
+    // tears there).
+    virtual Eigen::Vector3d alongTorn(const Eigen::Vector3d& /*x*/) const {
+        return Eigen::Vector3d::Zero();
+    }
+
     double forwardTolerance() const { return forwardTolerance_; }
 
   protected:
@@ -57,6 +75,7 @@ class StepDeformation {
     Box affected_;
     double forwardTolerance_ = 1e-12;
     int forwardMaxIterations_ = 500;
+    bool tears_ = false;
 };
 
 } // namespace sweepers

@@ -208,6 +208,29 @@ InflateStroke readInflate(const Reader& r, const json& v, const std::string& at)
     return s;
 }
 
+// A pinch or a strangle: the same fields, checked by the tool's own rules.
+template <typename StrokeT, typename Check>
+StrokeT readTopologyTool(const Reader& r, const json& v, const std::string& at, Check check) {
+    r.onlyKeys(v, at, {"type", "at", "axis", "size", "falloff", "open"});
+    StrokeT s;
+    s.at = r.vec3(r.require(v, at, "at"), at + "/at");
+    s.axis = r.vec3(r.require(v, at, "axis"), at + "/axis");
+    if (!(s.axis.norm() > 0.0)) r.fail(at + "/axis", "needs a direction (not zero)");
+    s.size = r.positive(r.require(v, at, "size"), at + "/size");
+    s.falloff = r.positive(r.require(v, at, "falloff"), at + "/falloff");
+    s.open = r.positive(r.require(v, at, "open"), at + "/open");
+    try {
+        check(s);
+    } catch (const std::exception& e) {
+        // The message starts with the field it is about.
+        const std::string why = e.what();
+        const auto colon = why.find(": ");
+        if (colon == std::string::npos) r.fail(at, why);
+        r.fail(at + "/" + why.substr(0, colon), why.substr(colon + 2));
+    }
+    return s;
+}
+
 StartShape readStart(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, {"sphere", "vdb", "mesh", "grid"});
     if (v.size() - v.contains("grid") != 1) r.fail(at, "expected exactly one of sphere, vdb, mesh");
@@ -261,6 +284,11 @@ json placementJson(const Placement& p) {
             j["s"] = vecJson(p.scale);
     }
     return j;
+}
+
+template <typename Spec> json topologyToolJson(const char* type, const Spec& s) {
+    return {{"type", type},   {"at", vecJson(s.at)},  {"axis", vecJson(s.axis)},
+            {"size", s.size}, {"falloff", s.falloff}, {"open", s.open}};
 }
 
 const char* mirrorName(MirrorAxis m) {
@@ -389,9 +417,13 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name)
             s.strokes.emplace_back(readSwirl(r, v, at));
         else if (type == "inflate")
             s.strokes.emplace_back(readInflate(r, v, at));
+        else if (type == "pinch")
+            s.strokes.emplace_back(readTopologyTool<PinchStroke>(r, v, at, checkPinch));
+        else if (type == "strangle")
+            s.strokes.emplace_back(readTopologyTool<StrangleStroke>(r, v, at, checkStrangle));
         else
-            r.fail(at + "/type",
-                   "unknown stroke type \"" + type + "\" (expected sweep, swirl or inflate)");
+            r.fail(at + "/type", "unknown stroke type \"" + type +
+                                     "\" (expected sweep, swirl, inflate, pinch or strangle)");
     }
     return s;
 }
@@ -453,11 +485,14 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             j["ring"] = sr->ring == SwirlRing::Convolution ? "convolution" : "discrete";
             j["swirls"] = sr->swirls;
             if (sr->ball > 0.0) j["ball"] = sr->ball;
-        } else {
-            const auto& in = std::get<InflateStroke>(stroke);
+        } else if (const auto* in = std::get_if<InflateStroke>(&stroke)) {
             j["type"] = "inflate";
-            j["at"] = vecJson(in.at);
-            j["radius"] = in.radius;
+            j["at"] = vecJson(in->at);
+            j["radius"] = in->radius;
+        } else if (const auto* pinch = std::get_if<PinchStroke>(&stroke)) {
+            j = topologyToolJson("pinch", *pinch);
+        } else {
+            j = topologyToolJson("strangle", std::get<StrangleStroke>(stroke));
         }
         strokes.push_back(j);
     }

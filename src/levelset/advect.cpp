@@ -115,10 +115,17 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 // map(x), and marks in `changed` the voxels whose value changed. When the source holds the
 // grid's own values (`sourceIsGrid`: no widened band), a voxel that the map leaves in place
 // keeps its value without interpolating: a sample at a voxel centre returns it exactly.
+// A deformation that tears space (`tearing`) adds how deep x lies in what it opened. A point
+// it opened reads the largest value along the torn set within `tornWindow` of the point it
+// was torn from: on a grid, what the pinch's needles bring together (or the strangle's noose
+// squeezes) keeps a membrane a few voxels thick where the exact surface meets itself at one
+// point (the grid rounds off the funnels' tips), and the tear opens through it instead of
+// keeping it as the rim of the hole.
 template <typename Map>
 std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const SampleSource& source,
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
-                     Sampling sampling, openvdb::MaskGrid& changed, Interrupter* interrupter) {
+                     const StepDeformation* tearing, double tornWindow, Sampling sampling,
+                     openvdb::MaskGrid& changed, Interrupter* interrupter) {
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> marks;
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
@@ -134,11 +141,19 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                 const Eigen::Vector3d y = map(x);
                 float v = *it;
                 if (y != x || !sourceIsGrid) {
-                    const openvdb::Vec3d p = xform.worldToIndex(toVdb(y));
-                    if (sampling == Sampling::Trilinear)
-                        v = acc.trilinear(p);
-                    else
-                        v = float(sampleMonotoneCubic(acc, p));
+                    const auto sample = [&](const Eigen::Vector3d& at) {
+                        const openvdb::Vec3d p = xform.worldToIndex(toVdb(at));
+                        return sampling == Sampling::Trilinear ? acc.trilinear(p)
+                                                               : float(sampleMonotoneCubic(acc, p));
+                    };
+                    v = sample(y);
+                    const double depth = tearing ? tearing->openedDepth(x) : 0.0;
+                    if (depth > 0.0) {
+                        const Eigen::Vector3d along = tearing->alongTorn(x) * (0.5 * tornWindow);
+                        for (int t = -2; t <= 2; ++t)
+                            if (t != 0) v = std::max(v, sample(y + double(t) * along));
+                        v += float(depth);
+                    }
                 }
                 if (v != *it || !acc.isValueOn(ijk)) marks.local().push_back(ijk);
                 it.setValue(v);
@@ -151,6 +166,51 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     for (const auto& m : marks)
         for (const openvdb::Coord& c : m)
             macc.setValueOn(c);
+    return count;
+}
+
+// Marks in `mask` what a tearing deformation needs sampled beyond the band grown around the
+// images of the surface: the inside voxels of the opened region (their sign changes), and
+// the voxels within `shell` of the opening's rim whose value will lie within `shell` of the
+// surface. Where the surface touched the torn set, the rim is new surface, and the images of
+// the few voxels near the touching point only reach it in their own directions.
+std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shell,
+                       openvdb::MaskGrid& mask) {
+    const openvdb::CoordBBox box = indexBox(grid, seg.openedBox().expanded(shell), 1);
+    if (box.empty()) return 0;
+    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> found;
+    const SampleSource source(grid, Grid::create()); // the grid itself, nothing copied
+    tbb::parallel_for(tbb::blocked_range<int>(box.min().x(), box.max().x() + 1),
+                      [&](const auto& r) {
+                          const SampleSource::Accessor acc(source);
+                          const auto live = grid.getConstAccessor();
+                          auto& out = found.local();
+                          for (int i = r.begin(); i != r.end(); ++i)
+                              for (int j = box.min().y(); j <= box.max().y(); ++j)
+                                  for (int k = box.min().z(); k <= box.max().z(); ++k) {
+                                      const openvdb::Coord ijk(i, j, k);
+                                      float v;
+                                      if (live.probeValue(ijk, v)) continue; // in the band already
+                                      const Eigen::Vector3d x = toEigen(grid.indexToWorld(ijk));
+                                      const double depth = seg.openedDepth(x);
+                                      if (depth < -shell) continue;
+                                      bool mark = depth > 0.0 && v < 0.0f;
+                                      if (!mark && std::abs(depth) <= shell) {
+                                          const Eigen::Vector3d p = seg.inverseMap(x);
+                                          mark = acc.trilinear(grid.worldToIndex(toVdb(p))) +
+                                                     std::max(0.0, depth) <
+                                                 shell;
+                                      }
+                                      if (mark) out.push_back(ijk);
+                                  }
+                      });
+    std::size_t count = 0;
+    auto macc = mask.getAccessor();
+    for (const auto& f : found) {
+        for (const openvdb::Coord& c : f)
+            macc.setValueOn(c);
+        count += f.size();
+    }
     return count;
 }
 
@@ -263,6 +323,10 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     }
     const int dilation = int(std::ceil(halfWidth)) + 1;
     dilateByCube(mask->tree(), dilation);
+    // A tear opens empty space where there was material: no image of the surface reaches
+    // the middle of the opening, so the inside voxels there join the band to be sampled
+    // (renormalization drops them again, with their new sign).
+    if (seg.tears()) stats.tornVoxels = markOpened(grid, seg, (halfWidth + 2) * h, *mask);
     double maxStretch = 1.0;
     for (double s : stretch)
         maxStretch = std::max(maxStretch, s);
@@ -336,10 +400,12 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // whose signs may now be wrong (space pulled out of the shape is inside it now):
     // re-derive the inactive signs there (and in the band grown around it) from the band.
     const openvdb::CoordBBox touched = changedRegion(grid, seg);
+    const double tornWindow = (std::ceil(halfWidth) + 1) * h; // see resample
     if (!options.resampleEachSubStep) {
         stats.sampledVoxels = resample(
             grid, moving, *source(0), !widened, region,
-            [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); }, options.sampling, *changed,
+            [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); },
+            seg.tears() ? &seg : nullptr, tornWindow, options.sampling, *changed,
             options.interrupter);
     } else {
         // Each sub-step reads what the one before wrote, inactive values included, so their
@@ -349,8 +415,9 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             if (k > 0) stats.leavesFlooded += floodSignsIn(grid.tree(), touched);
             stats.sampledVoxels += resample(
                 grid, moving, *source(k), !widened || k > 0, region,
-                [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); }, options.sampling,
-                *changed, options.interrupter);
+                [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); },
+                seg.tears() ? &seg : nullptr, tornWindow, options.sampling, *changed,
+                options.interrupter);
         }
     }
     stats.voxelsVisited += stats.sampledVoxels;

@@ -45,6 +45,7 @@ struct AdvectStats {
     std::size_t leavesVisited = 0; // leaves those loops went through
     std::size_t leavesCopied = 0;  // copied as the sampling source
     std::size_t leavesFlooded = 0; // whose inactive signs were re-derived
+    std::size_t tornVoxels = 0;    // inside voxels beyond the band that a tear opened
     double growSeconds = 0.0, sampleSeconds = 0.0, renormalizeSeconds = 0.0;
     openvdb::CoordBBox touched; // index box whose values may have changed
 };

@@ -72,7 +72,7 @@ std::vector<SegmentReport> applyStrokes(Sculptor& sculptor, const std::vector<St
                                         History* history) {
     std::size_t total = 0, done = 0;
     for (const Stroke& s : strokes)
-        total += segmentCount(s);
+        total += segmentCount(s, sculptor.grid().voxelSize()[0]);
     std::vector<SegmentReport> reports;
     for (std::size_t i = 0; i < strokes.size(); ++i) {
         sculptor.applyStroke(strokes[i], [&](const SegmentReport& r) {

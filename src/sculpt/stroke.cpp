@@ -35,9 +35,12 @@ SwirlSpec toSwirl(const SwirlStroke& stroke) {
     return s;
 }
 
-std::size_t segmentCount(const Stroke& stroke) {
+std::size_t segmentCount(const Stroke& stroke, double voxelSize) {
     if (const auto* sweep = std::get_if<SweepStroke>(&stroke))
         return toSweep(*sweep).segmentCount();
+    if (const auto* pinch = std::get_if<PinchStroke>(&stroke)) return pinchSegmentCount(*pinch);
+    if (const auto* strangle = std::get_if<StrangleStroke>(&stroke))
+        return planStrangle(*strangle, voxelSize).size();
     return 1;
 }
 
@@ -62,6 +65,8 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                    [&](const InflateStroke& s) {
                        parts.push_back(std::make_unique<Inflation>(s.at, s.radius, reach()));
                    },
+                   [&](const PinchStroke& s) { parts = planPinch(s, grid.voxelSize()[0]); },
+                   [&](const StrangleStroke& s) { parts = planStrangle(s, grid.voxelSize()[0]); },
                },
                stroke);
     return parts;

@@ -5,6 +5,9 @@
 //   sweep   - tools (balls or ellipsoids) moved along paths of placements (thesis 3.3)
 //   swirl   - a ring of swirls carrying clay while keeping its volume (4.1-4.19)
 //   inflate - Decaudin's inflation adding a ball of material (2.30)
+//   pinch   - two needles poke a hole through the shape, then pull it open (3.5.1)
+//   strangle - a circle contracts around a limb until it parts, then pulls the parts apart
+//             (3.5.2)
 #pragma once
 
 #include <cstddef>
@@ -15,8 +18,10 @@
 
 #include <Eigen/Core>
 
+#include "deform/pinch.h"
 #include "deform/placement.h"
 #include "deform/step_deformation.h"
+#include "deform/strangle.h"
 #include "deform/sweep.h"
 #include "deform/swirl.h"
 #include "levelset/vdb.h"
@@ -67,7 +72,10 @@ struct InflateStroke {
     double radius = 0.1;
 };
 
-using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke>;
+struct PinchStroke : PinchSpec {};
+struct StrangleStroke : StrangleSpec {};
+
+using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke, PinchStroke, StrangleStroke>;
 
 struct StrokeScript {
     int version = 1;
@@ -81,11 +89,13 @@ Sweep toSweep(const SweepStroke& stroke);
 // The swirl ring a swirl stroke describes.
 SwirlSpec toSwirl(const SwirlStroke& stroke);
 
-// How many deformations planStroke makes of a stroke (a sweep's segments, else one).
-std::size_t segmentCount(const Stroke& stroke);
+// How many deformations planStroke makes of a stroke at the given voxel size (a sweep's
+// segments, a pinch's or a strangle's segments and its pull, else one).
+std::size_t segmentCount(const Stroke& stroke, double voxelSize);
 
-// The deformations of one stroke, in order: a sweep's segments, or one swirl ring or
-// inflation (whose reach depends on the grid as it is when the stroke comes).
+// The deformations of one stroke, in order: a sweep's segments, one swirl ring or
+// inflation (whose reach depends on the grid as it is when the stroke comes), or the
+// segments of a pinch or a strangle (whose sub-steps depend on the voxel size).
 std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke);
 
 } // namespace sweepers

@@ -1,5 +1,6 @@
 #include "study/reference.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -42,7 +43,15 @@ Eigen::Vector3d ExactReference::pullBack(const Eigen::Vector3d& x) const {
 }
 
 double ExactReference::value(const Eigen::Vector3d& x) const {
-    return start_(pullBack(x));
+    // A deformation that tears space adds, at the point it is given, how deep that point
+    // lies in what it opened (tear.h).
+    Eigen::Vector3d p = x;
+    double opened = 0.0;
+    for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
+        if ((*it)->tears()) opened += std::max(0.0, (*it)->openedDepth(p));
+        p = (*it)->inverseMap(p);
+    }
+    return start_(p) + opened;
 }
 
 std::optional<Eigen::Vector3d> ExactReference::crossing(const Eigen::Vector3d& a,

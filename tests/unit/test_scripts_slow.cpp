@@ -43,6 +43,17 @@ class DataScript : public ::testing::TestWithParam<const char*> {};
 
 } // namespace
 
+// The share of interface voxels whose |grad phi| lies in [0.9, 1.1]. A pinch or a strangle
+// tears a hole whose rim is a crease of the exact shape (the image of the point where the
+// surface met itself), where central differences straddle the crease. The crease's share of
+// the interface doubles with the voxel size: at the scripts' 1/64 they keep 95%, at the
+// coarse variant's 1/32 they keep 84.9% (two_handles) to 94.9%.
+double minimumUnitGradientFraction(const std::string& name) {
+    const bool tears = name == "pinch_torus" || name == "strangle_torus" || name == "two_handles" ||
+                       name == "severed_horn";
+    return tears && coarse() ? 0.8 : 0.95;
+}
+
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
     const std::string name = GetParam();
     const StrokeScript script = readStrokeScript(dataPath(name));
@@ -50,7 +61,8 @@ TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
     applyScript(script, SWEEPERS_DATA_DIR, h, [&](std::size_t stroke, const Grid& g) {
         const BandReport r = checkBand(g);
         EXPECT_EQ(r.vdbCheck, "") << name << " stroke " << stroke;
-        EXPECT_GE(r.unitGradientFraction(), 0.95) << name << " stroke " << stroke;
+        EXPECT_GE(r.unitGradientFraction(), minimumUnitGradientFraction(name))
+            << name << " stroke " << stroke;
         EXPECT_EQ(r.beyondBand, 0u) << name << " stroke " << stroke;
         std::printf("[ band ] %s at 1/%g, stroke %zu: %zu active, |grad| in [0.9, 1.1] on "
                     "%.2f%% of %zu interface voxels\n",
@@ -60,8 +72,9 @@ TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Data, DataScript,
-                         ::testing::Values("drag", "horn", "mirrored_ears", "pinch", "pull",
-                                           "starfish_swirls", "twisted_limb"),
+                         ::testing::Values("drag", "horn", "mirrored_ears", "pinch", "pinch_torus",
+                                           "pull", "severed_horn", "starfish_swirls",
+                                           "strangle_torus", "twisted_limb", "two_handles"),
                          [](const auto& info) { return std::string(info.param); });
 
 TEST(DataScripts, EveryScriptInDataIsCovered) {
@@ -69,7 +82,7 @@ TEST(DataScripts, EveryScriptInDataIsCovered) {
     std::size_t scripts = 0;
     for (const auto& entry : std::filesystem::directory_iterator(SWEEPERS_DATA_DIR))
         scripts += entry.path().extension() == ".json";
-    EXPECT_EQ(scripts, 7u);
+    EXPECT_EQ(scripts, 11u);
 }
 
 TEST(Advect, PinchOpensAHole) {

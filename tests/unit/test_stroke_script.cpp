@@ -170,6 +170,21 @@ TEST(StrokeScript, BadInputIsRefusedWithFileLocationAndReason) {
          "/start/grid", "this start is not a VDB file"},
         {R"({"sweepers": 1, "start": {"grid": "b"}, "strokes": []})", "/start", "exactly one"},
         {R"([1, 2])", "/", "expected an object"},
+        {withStroke(
+             R"({"type": "pinch", "at": [0,0,0], "axis": [0,0,0], "size": 1, "falloff": 0.3, "open": 0.1})"),
+         "/strokes/0/axis", "needs a direction"},
+        {withStroke(
+             R"({"type": "pinch", "at": [0,0,0], "axis": [0,1,0], "size": 1, "falloff": 0.3, "open": -0.1})"),
+         "/strokes/0/open", "must be positive"},
+        {withStroke(
+             R"({"type": "pinch", "at": [0,0,0], "axis": [0,1,0], "size": 1e6, "falloff": 0.001, "open": 0.1})"),
+         "/strokes/0/size", "over 1000 falloffs"},
+        {withStroke(
+             R"({"type": "strangle", "at": [0,0,0], "axis": [0,1,0], "size": 1, "falloff": 0.3})"),
+         "/strokes/0/open", "missing field"},
+        {withStroke(
+             R"({"type": "strangle", "at": [0,0,0], "axis": [0,1,0], "size": 1, "falloff": 0.3, "open": 0.2, "gap": 1})"),
+         "/strokes/0/gap", "unknown field"},
     };
     for (const Bad& b : bad) {
         const std::string msg = errorOf(b.text);
@@ -178,6 +193,29 @@ TEST(StrokeScript, BadInputIsRefusedWithFileLocationAndReason) {
         EXPECT_NE(msg.find(b.reason), std::string::npos) << msg << "\n  wanted " << b.reason;
         EXPECT_EQ(msg.find('\n'), std::string::npos) << "one line: " << msg;
     }
+}
+
+TEST(StrokeScript, TopologyToolsRoundTrip) {
+    const StrokeScript a = parseStrokeScript(
+        withStroke(
+            R"({"type": "pinch", "at": [0.1, 0, 0], "axis": [0, 2, 0], "size": 1.25, "falloff": 0.4, "open": 0.3},
+                      {"type": "strangle", "at": [0, 1.4, 0], "axis": [0, 1, 0], "size": 0.6, "falloff": 0.25, "open": 0.2})"),
+        "tools.json");
+    ASSERT_EQ(a.strokes.size(), 2u);
+    const auto& pinch = std::get<PinchStroke>(a.strokes[0]);
+    EXPECT_EQ(pinch.at, Eigen::Vector3d(0.1, 0, 0));
+    EXPECT_EQ(pinch.axis, Eigen::Vector3d(0, 2, 0));
+    EXPECT_EQ(pinch.size, 1.25);
+    EXPECT_EQ(pinch.falloff, 0.4);
+    EXPECT_EQ(pinch.open, 0.3);
+    const auto& strangle = std::get<StrangleStroke>(a.strokes[1]);
+    EXPECT_EQ(strangle.at, Eigen::Vector3d(0, 1.4, 0));
+    EXPECT_EQ(strangle.open, 0.2);
+    const std::string once = formatStrokeScript(a);
+    EXPECT_EQ(formatStrokeScript(parseStrokeScript(once, "again.json")), once);
+    // A pinch is its needles' segments and the pull; a strangle, the noose's and the pull.
+    EXPECT_EQ(segmentCount(a.strokes[0], 1.0 / 32), 14u);
+    EXPECT_GT(segmentCount(a.strokes[1], 1.0 / 32), 2u);
 }
 
 TEST(StrokeScript, MissingFileIsAScriptError) {
