@@ -249,6 +249,10 @@ std::string studyCsv(const std::vector<StudyRow>& rows) {
         const auto num = [&](double v, int digits = 7) { return ran ? number(v, digits) : ""; };
         const auto count = [&](std::size_t v) { return ran ? std::to_string(v) : ""; };
         const auto integer = [&](int v) { return ran ? std::to_string(v) : ""; };
+        // The exact topology's columns stay empty where it is not known.
+        const auto known = [&](const std::string& v) {
+            return r.referenceTopologyKnown ? v : std::string();
+        };
         out << field(r.variant) << "," << number(r.voxelSize, 17) << "," << num(r.wallSeconds)
             << "," << num(r.advectSeconds) << "," << num(r.renormSeconds) << ","
             << num(r.meshSeconds) << "," << num(r.peakRssMb) << "," << count(r.activeVoxels) << ","
@@ -257,8 +261,8 @@ std::string studyCsv(const std::vector<StudyRow>& rows) {
             << num(r.error.mean) << "," << num(r.error.rms) << "," << num(r.error.max) << ","
             << num(voxelsOf(r)) << "," << count(r.error.signFlips) << "," << num(r.orderRms, 4)
             << "," << num(r.error.referenceVolume, 12) << "," << num(r.error.volumeError(), 7)
-            << "," << num(r.orderVolume, 4) << "," << integer(r.referenceEuler) << ","
-            << integer(r.referenceGenus) << "," << count(r.referenceComponents) << ","
+            << "," << num(r.orderVolume, 4) << "," << known(integer(r.referenceEuler)) << ","
+            << known(integer(r.referenceGenus)) << "," << known(count(r.referenceComponents)) << ","
             << count(r.error.samples) << "," << count(r.error.unmatched) << "," << field(r.failure)
             << "\n";
     }
@@ -320,9 +324,12 @@ std::vector<StudyRow> readStudyCsv(const std::string& path) {
         r.error.referenceVolume = real("volume_ref");
         r.error.meshVolume = r.error.referenceVolume + real("volume_err");
         r.orderVolume = real("order_volume");
-        r.referenceEuler = int(whole("ref_euler", -kMaxTopology, kMaxTopology));
-        r.referenceGenus = int(whole("ref_genus", -kMaxTopology, kMaxTopology));
-        r.referenceComponents = std::size_t(whole("ref_components", 0, kMaxCount));
+        r.referenceTopologyKnown = !at("ref_euler").empty();
+        if (r.referenceTopologyKnown) {
+            r.referenceEuler = int(whole("ref_euler", -kMaxTopology, kMaxTopology));
+            r.referenceGenus = int(whole("ref_genus", -kMaxTopology, kMaxTopology));
+            r.referenceComponents = std::size_t(whole("ref_components", 0, kMaxCount));
+        }
         r.error.samples = std::size_t(whole("err_samples", 0, kMaxCount));
         r.error.unmatched = std::size_t(whole("unmatched", 0, kMaxCount));
         rows.push_back(r);
@@ -332,8 +339,9 @@ std::vector<StudyRow> readStudyCsv(const std::string& path) {
 
 std::string studyReport(const std::vector<StudyRow>& rows, const std::string& script) {
     const auto changed = [](const StudyRow& r) {
-        return r.euler != r.referenceEuler || r.genus != r.referenceGenus ||
-               r.components != r.referenceComponents;
+        return r.referenceTopologyKnown &&
+               (r.euler != r.referenceEuler || r.genus != r.referenceGenus ||
+                r.components != r.referenceComponents);
     };
     const auto topology = [](const StudyRow& r) {
         return "Euler " + std::to_string(r.referenceEuler) + ", genus " +
@@ -353,7 +361,9 @@ std::string studyReport(const std::vector<StudyRow>& rows, const std::string& sc
            "tessellation); its order is that of its size. The exact shape keeps the start's "
            "topology, since every sub-step is a fold-over-free deformation of space; where a "
            "run's topology differs, the grid lost a feature thinner than it resolves, and "
-           "its components column gives the exact topology.\n\n"
+           "its components column gives the exact topology. A pinch or a strangle tears space "
+           "on purpose, and the exact topology of a history that holds one is not known here: "
+           "no run of it is marked.\n\n"
         << "| variant | voxel size | err RMS (voxels) | err max (voxels) | err RMS | order (RMS) "
            "| sign flips | volume error | order (volume) | volume change | Euler | genus "
            "| components | time (s) |\n"

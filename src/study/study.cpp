@@ -186,6 +186,9 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
     row.referenceEuler = before.eulerCharacteristic;
     row.referenceGenus = before.genus;
     row.referenceComponents = before.components;
+    for (const Stroke& s : strokes)
+        if (std::holds_alternative<PinchStroke>(s) || std::holds_alternative<StrangleStroke>(s))
+            row.referenceTopologyKnown = false;
 
     AdvectOptions options = variantOptions(variant);
     options.interrupter = interrupter;

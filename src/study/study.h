@@ -64,6 +64,9 @@ struct StudyRow {
     // grid changed the topology (a feature thinner than it resolves).
     int referenceEuler = 0, referenceGenus = 0;
     std::size_t referenceComponents = 0;
+    // False when a stroke tears space (a pinch or a strangle): the exact topology is then
+    // not the start's, and the study does not claim one.
+    bool referenceTopologyKnown = true;
     InterfaceError error;
     // Observed order of the RMS error against the next coarser run of the same variant
     // (NaN for the coarsest): p = log(e_coarse / e_fine) / log(h_coarse / h_fine).

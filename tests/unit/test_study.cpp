@@ -76,6 +76,22 @@ TEST(Study, TheReportMarksARunWhoseTopologyIsNotTheExactShapes) {
     EXPECT_NE(report.find("| 0.04% | 2.32 |"), std::string::npos) << report;
 }
 
+TEST(Study, AHistoryThatTearsSpaceClaimsNoExactTopology) {
+    // A pinch made a torus: the start's topology is not the exact one, and nothing is marked.
+    std::vector<StudyRow> rows = {row("trilinear", 1.0 / 32, 4e-3)};
+    rows[0].euler = 0;
+    rows[0].genus = 1;
+    rows[0].referenceTopologyKnown = false;
+    const std::string report = studyReport(rows, "pinch_torus.json");
+    EXPECT_EQ(report.find("(exact:"), std::string::npos) << report;
+    const std::string path = ::testing::TempDir() + "study_torn.csv";
+    std::ofstream(path) << studyCsv(rows);
+    const std::vector<StudyRow> back = readStudyCsv(path);
+    ASSERT_EQ(back.size(), 1u);
+    EXPECT_FALSE(back[0].referenceTopologyKnown);
+    EXPECT_EQ(back[0].genus, 1);
+}
+
 TEST(Study, TableReadsBackWhatWasWritten) {
     std::vector<StudyRow> rows = {row("trilinear", 1.0 / 32, 4e-3, 1e-3),
                                   row("trilinear", 1.0 / 64, 1e-3)};
@@ -99,6 +115,7 @@ TEST(Study, TableReadsBackWhatWasWritten) {
     EXPECT_NEAR(back[1].orderVolume, 2.0, 1e-3);
     EXPECT_EQ(back[1].referenceEuler, 2);
     EXPECT_EQ(back[1].referenceComponents, 1u);
+    EXPECT_TRUE(back[1].referenceTopologyKnown);
     EXPECT_EQ(back[2].failure, rows[2].failure);
     EXPECT_EQ(studyRunName(back[1]), "trilinear_64");
     EXPECT_EQ(studyRunName(back[2]), "cubic_0.03");
