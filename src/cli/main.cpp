@@ -56,50 +56,43 @@ int runCheck(const std::string& path, bool asJson) {
     const StrokeScript script = readStrokeScript(path);
     requireBuildableStart(script); // the limits apply holds the script to
     json out = json::array();
+    // One row per deformation: its stroke, kind, tools, sub-steps and reach.
+    const auto row = [&](std::size_t stroke, const std::string& type, std::size_t segment,
+                         std::size_t tools, const StepDeformation& seg, double bound) {
+        out.push_back({{"stroke", stroke},
+                       {"type", type},
+                       {"segment", segment},
+                       {"tools", tools},
+                       {"steps", seg.steps()},
+                       {"bound", bound},
+                       {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
+    };
     for (std::size_t i = 0; i < script.strokes.size(); ++i) {
-        if (const auto* sweep = std::get_if<SweepStroke>(&script.strokes[i])) {
+        const Stroke& stroke = script.strokes[i];
+        if (const auto* sweep = std::get_if<SweepStroke>(&stroke)) {
             const Sweep sw = toSweep(*sweep);
             for (std::size_t k = 0; k < sw.segmentCount(); ++k) {
                 const SweepSegment seg(sw, k);
-                out.push_back(
-                    {{"stroke", i},
-                     {"type", "sweep"},
-                     {"segment", k},
-                     {"tools", seg.toolCount()},
-                     {"steps", seg.steps()},
-                     {"bound", seg.stepBound()},
-                     {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
+                row(i, "sweep", k, seg.toolCount(), seg, seg.stepBound());
             }
-        } else if (const auto* swirl = std::get_if<SwirlStroke>(&script.strokes[i])) {
-            const SwirlSegment seg(toSwirl(*swirl));
-            out.push_back(
-                {{"stroke", i},
-                 {"type", swirl->ball > 0 ? "star-shaped swirl" : "swirl"},
-                 {"segment", 0},
-                 {"tools", 1},
-                 {"steps", seg.steps()},
-                 {"bound", 0.0},
-                 {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
-        } else if (std::holds_alternative<InflateStroke>(script.strokes[i])) {
+        } else if (const auto* swirl = std::get_if<SwirlStroke>(&stroke)) {
+            row(i, swirl->ball > 0 ? "star-shaped swirl" : "swirl", 0, 1,
+                SwirlSegment(toSwirl(*swirl)), 0.0);
+        } else if (std::holds_alternative<InflateStroke>(stroke)) {
             out.push_back({{"stroke", i}, {"type", "inflate"}});
         } else {
             // A pinch or a strangle: its sub-steps depend on the voxel size (the script's).
-            const auto* pinch = std::get_if<PinchStroke>(&script.strokes[i]);
+            const auto* pinch = std::get_if<PinchStroke>(&stroke);
             const double h = script.grid.voxelSize;
-            const auto parts = pinch ? planPinch(*pinch, h)
-                                     : planStrangle(std::get<StrangleStroke>(script.strokes[i]), h);
+            const auto parts =
+                pinch ? planPinch(*pinch, h) : planStrangle(std::get<StrangleStroke>(stroke), h);
             for (std::size_t k = 0; k < parts.size(); ++k) {
-                const StepDeformation& seg = *parts[k];
-                out.push_back(
-                    {{"stroke", i},
-                     {"type", std::string(pinch ? "pinch" : "strangle") + (seg.tears() ? " pull"
-                                                                           : pinch     ? " needles"
-                                                                                       : " noose")},
-                     {"segment", k},
-                     {"tools", 1},
-                     {"steps", seg.steps()},
-                     {"bound", 0.0},
-                     {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
+                const bool pull = parts[k]->tears();
+                row(i,
+                    std::string(pinch ? "pinch" : "strangle") + (pull    ? " pull"
+                                                                 : pinch ? " needles"
+                                                                         : " noose"),
+                    k, pinch && !pull ? 2 : 1, *parts[k], 0.0);
             }
         }
     }

@@ -178,32 +178,30 @@ std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shel
                        openvdb::MaskGrid& mask) {
     const openvdb::CoordBBox box = indexBox(grid, seg.openedBox().expanded(shell), 1);
     if (box.empty()) return 0;
-    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> found;
     const SampleSource source(grid, Grid::create()); // the grid itself, nothing copied
-    tbb::parallel_for(tbb::blocked_range<int>(box.min().x(), box.max().x() + 1),
-                      [&](const auto& r) {
-                          const SampleSource::Accessor acc(source);
-                          const auto live = grid.getConstAccessor();
-                          auto& out = found.local();
-                          for (int i = r.begin(); i != r.end(); ++i)
-                              for (int j = box.min().y(); j <= box.max().y(); ++j)
-                                  for (int k = box.min().z(); k <= box.max().z(); ++k) {
-                                      const openvdb::Coord ijk(i, j, k);
-                                      float v;
-                                      if (live.probeValue(ijk, v)) continue; // in the band already
-                                      const Eigen::Vector3d x = toEigen(grid.indexToWorld(ijk));
-                                      const double depth = seg.openedDepth(x);
-                                      if (depth < -shell) continue;
-                                      bool mark = depth > 0.0 && v < 0.0f;
-                                      if (!mark && std::abs(depth) <= shell) {
-                                          const Eigen::Vector3d p = seg.inverseMap(x);
-                                          mark = acc.trilinear(grid.worldToIndex(toVdb(p))) +
-                                                     std::max(0.0, depth) <
-                                                 shell;
-                                      }
-                                      if (mark) out.push_back(ijk);
-                                  }
-                      });
+    // Whether inactive voxel x (value v) is to be sampled.
+    const auto needed = [&](const Eigen::Vector3d& x, float v, const SampleSource::Accessor& acc) {
+        const double depth = seg.openedDepth(x);
+        if (depth > 0.0 && v < 0.0f) return true;
+        if (std::abs(depth) > shell) return false;
+        const Eigen::Vector3d p = seg.inverseMap(x);
+        return acc.trilinear(grid.worldToIndex(toVdb(p))) + std::max(0.0, depth) < shell;
+    };
+    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> found;
+    const tbb::blocked_range<int> slabs(box.min().x(), box.max().x() + 1);
+    tbb::parallel_for(slabs, [&](const auto& r) {
+        const SampleSource::Accessor acc(source);
+        const auto live = grid.getConstAccessor();
+        auto& out = found.local();
+        for (int i = r.begin(); i != r.end(); ++i)
+            for (int j = box.min().y(); j <= box.max().y(); ++j)
+                for (int k = box.min().z(); k <= box.max().z(); ++k) {
+                    const openvdb::Coord ijk(i, j, k);
+                    float v;
+                    if (live.probeValue(ijk, v)) continue; // in the band already
+                    if (needed(toEigen(grid.indexToWorld(ijk)), v, acc)) out.push_back(ijk);
+                }
+    });
     std::size_t count = 0;
     auto macc = mask.getAccessor();
     for (const auto& f : found) {
