@@ -119,6 +119,13 @@ ForwardResult PinchNeedles::forwardStep(int k, const Eigen::Vector3d& q, double 
     return r;
 }
 
+bool PinchNeedles::stillAt(const Eigen::Vector3d& p) const {
+    // Nothing moves farther than r_out from the tips' paths.
+    for (int n = 0; n < 2; ++n)
+        if (distanceToSegment(p, tip(n, u0_), tip(n, u1_)) < field_.rOut) return false;
+    return true;
+}
+
 bool PinchNeedles::identityOn(const Box& box) const {
     if (!affected_.overlaps(box)) return true;
     // Nothing moves farther than r_out from the tips' paths.

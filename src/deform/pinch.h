@@ -44,6 +44,7 @@ class PinchNeedles : public StepDeformation {
     ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
                               double tolerance = 0.0) const override;
     bool identityOn(const Box& box) const override;
+    bool stillAt(const Eigen::Vector3d& p) const override;
 
   private:
     // How far sub-step k moves p (the tips at tau_{k+1}).

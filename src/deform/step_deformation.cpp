@@ -10,7 +10,7 @@ Eigen::Vector3d StepDeformation::inverseStep(int k, const Eigen::Vector3d& p) co
 }
 
 Eigen::Vector3d StepDeformation::inverseMap(const Eigen::Vector3d& p) const {
-    if (!affected_.contains(p)) return p;
+    if (stillAt(p)) return p;
     Eigen::Vector3d q = p;
     for (int k = steps_ - 1; k >= 0; --k)
         q = inverseStep(k, q);

@@ -32,6 +32,10 @@ class StepDeformation {
     // box misses the affected box.
     virtual bool identityOn(const Box& box) const { return !affected_.overlaps(box); }
 
+    // True when no sub-step moves p (false when unsure): inverseMap then skips them all. By
+    // default, when p lies outside the affected box.
+    virtual bool stillAt(const Eigen::Vector3d& p) const { return !affected_.contains(p); }
+
     // Inverse of sub-step k.
     virtual Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const;
     // Whole inverse: inverse sub-steps s-1 down to 0.

@@ -92,6 +92,15 @@ ForwardResult StrangleNoose::forwardStep(int k, const Eigen::Vector3d& q, double
     return r;
 }
 
+bool StrangleNoose::stillAt(const Eigen::Vector3d& p) const {
+    // Outside the wedge for the smallest circle of the segment: outside it for every larger
+    // one, so no sub-step moves p (see identityOn).
+    const Eigen::Vector3d v = p - at_;
+    if (v.squaredNorm() >= field_.rOut * field_.rOut) return true;
+    const double z = v.dot(axis_);
+    return std::abs(z) >= tanOut_ * ((v - z * axis_).norm() - radii_.back());
+}
+
 bool StrangleNoose::identityOn(const Box& box) const {
     if (!affected_.overlaps(box)) return true;
     const Eigen::Vector3d centre = 0.5 * (box.min + box.max);

@@ -45,6 +45,7 @@ class StrangleNoose : public StepDeformation {
     ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
                               double tolerance = 0.0) const override;
     bool identityOn(const Box& box) const override;
+    bool stillAt(const Eigen::Vector3d& p) const override;
 
   private:
     // phi at p with the circle of radius R (3.43).

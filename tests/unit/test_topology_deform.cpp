@@ -180,6 +180,30 @@ TEST(Strangle, StillBoxesAreStill) {
     EXPECT_GT(still, 1000u);
 }
 
+TEST(TopologyTools, PointsCalledStillStayUnderEverySubStep) {
+    // stillAt lets inverseMap skip all sub-steps: each of them must leave such a point alone.
+    Rng rng(75);
+    std::vector<std::unique_ptr<StepDeformation>> parts = planStrangle(equatorStrangle(), 1.0 / 32);
+    for (auto& p : planPinch(diameterPinch(), 1.0 / 32))
+        parts.push_back(std::move(p));
+    std::size_t still = 0, moving = 0;
+    for (const auto& part : parts) {
+        if (part->tears()) continue;
+        for (int i = 0; i < 300; ++i) {
+            const Eigen::Vector3d p = rng.inBox(part->affectedBox().min, part->affectedBox().max);
+            if (!part->stillAt(p)) {
+                ++moving;
+                continue;
+            }
+            ++still;
+            for (int k = 0; k < part->steps(); ++k)
+                ASSERT_EQ(part->inverseStep(k, p), p) << "sub-step " << k;
+        }
+    }
+    EXPECT_GT(still, 1000u);
+    EXPECT_GT(moving, 1000u);
+}
+
 TEST(Strangle, TheCircleShrinksBelowAVoxelWithoutFolding) {
     const StrangleSpec spec = equatorStrangle();
     for (const double voxel : {1.0 / 32, 1.0 / 64}) {
