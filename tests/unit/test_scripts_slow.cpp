@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -54,6 +55,15 @@ double minimumUnitGradientFraction(const std::string& name) {
     return tears && coarse() ? 0.8 : 0.95;
 }
 
+// The topology after each stroke of the scripts that change it on purpose: Euler
+// characteristic (counted on the voxels and on the welded mesh) and components.
+const std::map<std::string, std::vector<std::pair<int, std::size_t>>> kTopology = {
+    {"pinch_torus", {{0, 1}}},            // a sphere pinched into a torus
+    {"two_handles", {{0, 1}, {-2, 1}}},   // two pinches: genus 2
+    {"strangle_torus", {{0, 1}, {2, 1}}}, // a torus whose tube is cut: a sphere again
+    {"severed_horn", {{2, 1}, {4, 2}}},   // a pulled horn, then cut off
+};
+
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
     const std::string name = GetParam();
     const StrokeScript script = readStrokeScript(dataPath(name));
@@ -64,6 +74,15 @@ TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
         EXPECT_GE(r.unitGradientFraction(), minimumUnitGradientFraction(name))
             << name << " stroke " << stroke;
         EXPECT_EQ(r.beyondBand, 0u) << name << " stroke " << stroke;
+        if (const auto it = kTopology.find(name); it != kTopology.end()) {
+            ASSERT_LT(stroke, it->second.size());
+            const auto [euler, components] = it->second[stroke];
+            const MeshTopology t = meshTopology(meshLevelSet(g));
+            EXPECT_EQ(topologicalEulerCharacteristic(g), euler) << name << " stroke " << stroke;
+            EXPECT_EQ(t.eulerCharacteristic(), euler) << name << " stroke " << stroke;
+            EXPECT_TRUE(t.watertight()) << name << " stroke " << stroke;
+            EXPECT_EQ(measureLevelSet(g).components, components) << name << " stroke " << stroke;
+        }
         std::printf("[ band ] %s at 1/%g, stroke %zu: %zu active, |grad| in [0.9, 1.1] on "
                     "%.2f%% of %zu interface voxels\n",
                     name.c_str(), 1.0 / h, stroke, r.activeVoxels, 100 * r.unitGradientFraction(),
