@@ -60,6 +60,8 @@ class StepDeformation {
     }
     // A box holding every point whose openedDepth is positive (empty when nothing tears).
     virtual Box openedBox() const { return {}; }
+    // How far the tear pushes its torn set open (0 when nothing tears).
+    virtual double opening() const { return 0.0; }
     // A unit direction along the torn set at the point x was torn from (zero when nothing
     // tears there).
     virtual Eigen::Vector3d alongTorn(const Eigen::Vector3d& /*x*/) const {

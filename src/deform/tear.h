@@ -30,7 +30,7 @@ class Tear : public StepDeformation {
     static Tear acrossDisc(const Eigen::Vector3d& centre, const Eigen::Vector3d& normal,
                            double radius, double open, double reach);
 
-    double open() const { return open_; }
+    double opening() const override { return open_; }
     double reach() const { return reach_; }
     // The nearest point of S.
     Eigen::Vector3d nearest(const Eigen::Vector3d& p) const;

@@ -171,19 +171,23 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
 
 // Marks in `mask` what a tearing deformation needs sampled beyond the band grown around the
 // images of the surface: the inside voxels of the opened region (their sign changes), and
-// the voxels within `shell` of the opening's rim whose value will lie within `shell` of the
-// surface. Where the surface touched the torn set, the rim is new surface, and the images of
-// the few voxels near the touching point only reach it in their own directions.
+// the voxels near the opening's rim whose value will lie within `shell` of the surface.
+// Where the surface touched the torn set, the rim is new surface, and the images of the few
+// voxels near the touching point only reach it in their own directions; around the rim the
+// tear stretches space along it by (d + r) / d at distance d from the torn set, and past a
+// stretch of 7 (d < r / 6, less than r / 6 beyond the rim) the images of neighbouring
+// voxels land farther apart than the band's dilation closes.
 std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shell,
                        openvdb::MaskGrid& mask) {
-    const openvdb::CoordBBox box = indexBox(grid, seg.openedBox().expanded(shell), 1);
+    const double beyond = shell + seg.opening() / 6.0; // how far past the rim to look
+    const openvdb::CoordBBox box = indexBox(grid, seg.openedBox().expanded(beyond), 1);
     if (box.empty()) return 0;
     const SampleSource source(grid, Grid::create()); // the grid itself, nothing copied
     // Whether inactive voxel x (value v) is to be sampled.
     const auto needed = [&](const Eigen::Vector3d& x, float v, const SampleSource::Accessor& acc) {
         const double depth = seg.openedDepth(x);
         if (depth > 0.0 && v < 0.0f) return true;
-        if (std::abs(depth) > shell) return false;
+        if (depth > shell || depth < -beyond) return false;
         const Eigen::Vector3d p = seg.inverseMap(x);
         return acc.trilinear(grid.worldToIndex(toVdb(p))) + std::max(0.0, depth) < shell;
     };
