@@ -105,7 +105,7 @@ ForwardResult PinchNeedles::forwardStep(int k, const Eigen::Vector3d& q, double 
     if (!affected_.contains(q)) return {q, true, 0};
     const double tol = (tolerance > 0.0 ? tolerance : forwardTolerance_) * (1.0 + q.norm());
     // p - displacement(p) = q: iterate p = q + displacement(p), a contraction away from the
-    // tips (the sub-step count keeps it one a voxel away from them).
+    // tips (the sub-step count keeps it one from a voxel away from them on).
     for (int it = 1; it <= kForwardIterations; ++it) {
         const Eigen::Vector3d next = q + displacement(k, r.p);
         const double change = (next - r.p).norm();
@@ -119,22 +119,20 @@ ForwardResult PinchNeedles::forwardStep(int k, const Eigen::Vector3d& q, double 
     return r;
 }
 
-bool PinchNeedles::stillAt(const Eigen::Vector3d& p) const {
+bool PinchNeedles::beyondReach(const Eigen::Vector3d& c, double margin) const {
     // Nothing moves farther than r_out from the tips' paths.
     for (int n = 0; n < 2; ++n)
-        if (distanceToSegment(p, tip(n, u0_), tip(n, u1_)) < field_.rOut) return false;
+        if (distanceToSegment(c, tip(n, u0_), tip(n, u1_)) < field_.rOut + margin) return false;
     return true;
 }
 
+bool PinchNeedles::stillAt(const Eigen::Vector3d& p) const {
+    return beyondReach(p, 0.0);
+}
+
 bool PinchNeedles::identityOn(const Box& box) const {
-    if (!affected_.overlaps(box)) return true;
-    // Nothing moves farther than r_out from the tips' paths.
-    const Eigen::Vector3d centre = 0.5 * (box.min + box.max);
-    const double radius = 0.5 * box.extent().norm();
-    for (int n = 0; n < 2; ++n)
-        if (distanceToSegment(centre, tip(n, u0_), tip(n, u1_)) < field_.rOut + radius)
-            return false;
-    return true;
+    return !affected_.overlaps(box) ||
+           beyondReach(0.5 * (box.min + box.max), 0.5 * box.extent().norm());
 }
 
 std::size_t pinchSegmentCount(const PinchSpec& spec) {

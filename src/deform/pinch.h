@@ -50,6 +50,8 @@ class PinchNeedles : public StepDeformation {
     // How far sub-step k moves p (the tips at tau_{k+1}).
     Eigen::Vector3d displacement(int k, const Eigen::Vector3d& p) const;
     double weight(int needle, const Eigen::Vector3d& tip, const Eigen::Vector3d& p) const;
+    // Whether every point within `margin` of c lies beyond the needles' reach.
+    bool beyondReach(const Eigen::Vector3d& c, double margin) const;
 
     Eigen::Vector3d at_, axis_;
     double size_, u0_, u1_;
