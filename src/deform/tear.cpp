@@ -84,7 +84,7 @@ double Tear::openedDepth(const Eigen::Vector3d& x) const {
 
 Eigen::Vector3d Tear::inverseStep(int, const Eigen::Vector3d& x) const {
     if (!affected_.contains(x)) return x;
-    const Eigen::Vector3d q = nearest(x);
+    Eigen::Vector3d q = nearest(x); // not const: returned as is below
     const double d = (x - q).norm();
     if (d >= reach_) return x;
     if (d <= open_) return q; // torn open: no pre-image but S itself

@@ -13,7 +13,7 @@ ExactReference::StartFunction ExactReference::sphere(const Eigen::Vector3d& cent
     return [center, radius](const Eigen::Vector3d& p) { return (p - center).norm() - radius; };
 }
 
-ExactReference::StartFunction ExactReference::sampled(GridPtr start) {
+ExactReference::StartFunction ExactReference::sampled(const GridPtr& start) {
     if (!start) throw std::invalid_argument("ExactReference::sampled: no start grid");
     return [start](const Eigen::Vector3d& p) {
         // One accessor per call keeps the function safe to call from several threads; the

@@ -27,7 +27,7 @@ class ExactReference {
     static StartFunction sphere(const Eigen::Vector3d& center, double radius);
     // A start grid sampled trilinearly (a start read from a file or a mesh): exact only up to
     // the start grid's own sampling, which a study has to say.
-    static StartFunction sampled(GridPtr start);
+    static StartFunction sampled(const GridPtr& start);
 
     explicit ExactReference(StartFunction start);
 
