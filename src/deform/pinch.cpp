@@ -101,22 +101,12 @@ Eigen::Vector3d PinchNeedles::inverseStep(int k, const Eigen::Vector3d& p) const
 }
 
 ForwardResult PinchNeedles::forwardStep(int k, const Eigen::Vector3d& q, double tolerance) const {
-    ForwardResult r{q, false, 0};
     if (!affected_.contains(q)) return {q, true, 0};
-    const double tol = (tolerance > 0.0 ? tolerance : forwardTolerance_) * (1.0 + q.norm());
-    // p - displacement(p) = q: iterate p = q + displacement(p), a contraction away from the
-    // tips (the sub-step count keeps it one from a voxel away from them on).
-    for (int it = 1; it <= kForwardIterations; ++it) {
-        const Eigen::Vector3d next = q + displacement(k, r.p);
-        const double change = (next - r.p).norm();
-        r.p = next;
-        r.iterations = it;
-        if (change <= tol) {
-            r.converged = true;
-            break;
-        }
-    }
-    return r;
+    // p - displacement(p) = q: a contraction away from the tips (the sub-step count keeps it
+    // one from a voxel away from them on).
+    return iterateForward(
+        q, tolerance, kForwardIterations,
+        [&](const Eigen::Vector3d& p) -> Eigen::Vector3d { return q + displacement(k, p); });
 }
 
 bool PinchNeedles::beyondReach(const Eigen::Vector3d& c, double margin) const {

@@ -19,20 +19,10 @@ Eigen::Vector3d StepDeformation::inverseMap(const Eigen::Vector3d& p) const {
 
 ForwardResult StepDeformation::forwardStep(int k, const Eigen::Vector3d& q,
                                            double tolerance) const {
-    ForwardResult r{q, false, 0};
-    const double tol = (tolerance > 0.0 ? tolerance : forwardTolerance_) * (1.0 + q.norm());
-    for (int it = 1; it <= forwardMaxIterations_; ++it) {
-        const std::optional<MotionLog> L = stepLog(k, r.p);
-        const Eigen::Vector3d next = L ? L->applyExp(q) : q;
-        const double change = (next - r.p).norm();
-        r.p = next;
-        r.iterations = it;
-        if (change <= tol) {
-            r.converged = true;
-            break;
-        }
-    }
-    return r;
+    return iterateForward(q, tolerance, forwardMaxIterations_, [&](const Eigen::Vector3d& p) {
+        const std::optional<MotionLog> L = stepLog(k, p);
+        return L ? L->applyExp(q) : q;
+    });
 }
 
 ForwardResult StepDeformation::forwardMap(const Eigen::Vector3d& p) const {

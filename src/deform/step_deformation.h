@@ -71,6 +71,27 @@ class StepDeformation {
     double forwardTolerance() const { return forwardTolerance_; }
 
   protected:
+    // Solves p = next(p) for the p that sub-step k maps back onto q, by fixed-point
+    // iteration from q to `tolerance` (relative to 1 + |q|; forwardTolerance() when 0), in
+    // at most maxIterations steps (converged false when they run out).
+    template <typename Next>
+    ForwardResult iterateForward(const Eigen::Vector3d& q, double tolerance, int maxIterations,
+                                 const Next& next) const {
+        ForwardResult r{q, false, 0};
+        const double tol = (tolerance > 0.0 ? tolerance : forwardTolerance_) * (1.0 + q.norm());
+        for (int it = 1; it <= maxIterations; ++it) {
+            const Eigen::Vector3d p = next(r.p);
+            const double change = (p - r.p).norm();
+            r.p = p;
+            r.iterations = it;
+            if (change <= tol) {
+                r.converged = true;
+                break;
+            }
+        }
+        return r;
+    }
+
     // L_k(p); nullopt where sub-step k leaves p in place. Deformations that are not of the
     // form exp(-L(p)) p override inverseStep and forwardStep instead.
     virtual std::optional<MotionLog> stepLog(int /*k*/, const Eigen::Vector3d& /*p*/) const {

@@ -76,20 +76,10 @@ Eigen::Vector3d StrangleNoose::inverseStep(int k, const Eigen::Vector3d& p) cons
 
 ForwardResult StrangleNoose::forwardStep(int k, const Eigen::Vector3d& q, double tolerance) const {
     if (!affected_.contains(q)) return {q, true, 0};
-    ForwardResult r{q, false, 0};
-    const double tol = (tolerance > 0.0 ? tolerance : forwardTolerance_) * (1.0 + q.norm());
     const double ratio = radius(k + 1) / radius(k);
-    for (int it = 1; it <= kForwardIterations; ++it) {
-        const Eigen::Vector3d next = scaled(q, std::pow(ratio, weight(radius(k + 1), r.p)));
-        const double change = (next - r.p).norm();
-        r.p = next;
-        r.iterations = it;
-        if (change <= tol) {
-            r.converged = true;
-            break;
-        }
-    }
-    return r;
+    return iterateForward(q, tolerance, kForwardIterations, [&](const Eigen::Vector3d& p) {
+        return scaled(q, std::pow(ratio, weight(radius(k + 1), p)));
+    });
 }
 
 bool StrangleNoose::stillAt(const Eigen::Vector3d& p) const {
