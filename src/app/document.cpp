@@ -256,7 +256,7 @@ void Document::saveVdb(const std::string& path) {
 }
 
 void Document::saveScript(const std::string& path) {
-    writeStrokeScript(withAbsoluteStart(script_, scriptDir_), path);
+    writeStrokeScript(withAbsoluteFiles(script_, scriptDir_), path);
 }
 
 Document Document::replayAt(StrokeScript script, const std::string& scriptDir, double voxelSize,

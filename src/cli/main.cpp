@@ -296,7 +296,7 @@ int runRecover(const std::string& where, const std::string& output, const std::s
     std::optional<AtomicWrite> scriptFile;
     if (!script.empty()) {
         const std::string text =
-            formatStrokeScript(withAbsoluteStart(state.script, state.scriptDir));
+            formatStrokeScript(withAbsoluteFiles(state.script, state.scriptDir));
         scriptFile.emplace(script, [&](std::ostream& out) { out << text; });
     }
     vdb.commit();

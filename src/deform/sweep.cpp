@@ -85,16 +85,18 @@ SweepSegment::SweepSegment(const Sweep& sweep, std::size_t index, const SegmentO
 
     // Sub-step count, 3.19: s > -sum_j min(mu_j') max_l |log M_j . p_l| over the corners of
     // the coating boxes. The thesis takes the box at the start only; a scale grows the
-    // coating, so the end box is measured too.
+    // coating, so the end box is measured too. The slope of phi is mu' times the slope of
+    // the distance: 1 for an exact distance, the shape's bound for a sampled one.
     double bound = 0.0;
     for (const Source& s : sources) {
-        double vmax = 0.0;
+        double vmax = 0.0, lipschitz = 1.0;
         for (const Eigen::Matrix4d& X : {s.XA, s.XB}) {
             const PlacedTool placed(s.tool->shape->place(affine(X)), s.tool->falloff);
             for (const Eigen::Vector3d& c : placed.coatingBounds().corners())
                 vmax = std::max(vmax, s.log.velocity(c).norm());
+            lipschitz = std::max(lipschitz, placed.lipschitz());
         }
-        bound += -falloffMuMinSlope(s.tool->falloff) * vmax;
+        bound += -falloffMuMinSlope(s.tool->falloff) * lipschitz * vmax;
     }
     stepBound_ = bound;
     if (!std::isfinite(bound) || bound >= kMaxSteps)
@@ -129,10 +131,12 @@ bool SweepSegment::identityOn(const Box& box) const {
         if (!stepBoxes_[k].overlaps(box)) continue;
         for (const ToolPlan& t : tools_) {
             const PlacedTool& tool = *t.placed[k + 1];
-            // A distance is 1-Lipschitz, so no point of the box is nearer the tool than
-            // distance(centre) - radius; the influence is 0 from the falloff width on (3.3).
-            // The margin covers the rounding of shapes whose distance is solved for.
-            if (tool.distance(centre) - radius < tool.falloff() * (1.0 + 1e-9) + 1e-12)
+            // The distance is L-Lipschitz (L = 1 unless sampled), so no point of the box is
+            // nearer the tool than distance(centre) - L radius; the influence is 0 from the
+            // falloff width on (3.3). The margin covers the rounding of shapes whose
+            // distance is solved for.
+            if (tool.distance(centre) - tool.lipschitz() * radius <
+                tool.falloff() * (1.0 + 1e-9) + 1e-12)
                 return false;
         }
     }

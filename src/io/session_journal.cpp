@@ -44,8 +44,10 @@ json strokesJson(const std::vector<Stroke>& strokes) {
     return json::parse(formatStrokeScript(s, -1))["strokes"];
 }
 
-std::vector<Stroke> readStrokes(const json& strokes, const std::string& name) {
-    return parseStrokeScript(json{{"sweepers", 1}, {"strokes", strokes}}.dump(), name).strokes;
+std::vector<Stroke> readStrokes(const json& strokes, const std::string& name,
+                                const std::string& scriptDir) {
+    return parseStrokeScript(json{{"sweepers", 1}, {"strokes", strokes}}.dump(), name, scriptDir)
+        .strokes;
 }
 
 } // namespace
@@ -123,10 +125,11 @@ JournalState readJournal(const std::string& dir) {
             if (line == 1) {
                 if (!j.is_object() || j.value("session", 0) != 1 || !j.contains("script"))
                     throw std::runtime_error("not a session journal");
-                st.script = parseStrokeScript(j.at("script").dump(), where);
                 st.scriptDir = j.at("dir").get<std::string>();
+                st.script = parseStrokeScript(j.at("script").dump(), where, st.scriptDir);
             } else if (j.contains("append")) {
-                const std::vector<Stroke> strokes = readStrokes(j.at("append"), where);
+                const std::vector<Stroke> strokes =
+                    readStrokes(j.at("append"), where, st.scriptDir);
                 st.script.strokes.insert(st.script.strokes.end(), strokes.begin(), strokes.end());
             } else if (j.contains("truncate")) {
                 const std::size_t n = j.at("truncate").get<std::size_t>();

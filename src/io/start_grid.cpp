@@ -14,7 +14,7 @@
 namespace sweepers {
 
 void requireMemoryForBand(double area, double voxelSize, double halfWidth, double bytesPerVoxel,
-                          bool force) {
+                          bool force, const std::string& what) {
     // The band is 2 halfWidth voxels thick over the surface.
     const double voxels = area / (voxelSize * voxelSize) * 2.0 * halfWidth;
     const double needed = voxels * bytesPerVoxel;
@@ -22,8 +22,8 @@ void requireMemoryForBand(double area, double voxelSize, double halfWidth, doubl
     if (force || available <= 0.0 || needed <= available) return;
     char count[32];
     std::snprintf(count, sizeof count, "%.2g", voxels);
-    throw ScriptError("the start shape needs about " + formatBytes(needed) + " of memory (" +
-                      count + " band voxels at voxel size " + formatNumber(voxelSize) +
+    throw ScriptError(what + " needs about " + formatBytes(needed) + " of memory (" + count +
+                      " band voxels at voxel size " + formatNumber(voxelSize) +
                       "), more than the " + formatBytes(available) +
                       " available; use a coarser voxel size, or --force to try anyway");
 }

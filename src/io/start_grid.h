@@ -28,8 +28,9 @@ void requireSphereSize(double radius, double voxelSize);
 constexpr double kSphereBytesPerVoxel = 32.0, kMeshBytesPerVoxel = 64.0;
 
 // Throws ScriptError when a band of `halfWidth` voxels around a surface of `area` would
-// need more memory than is available (unless `force`), with both figures in the message.
+// need more memory than is available (unless `force`), with both figures in the message,
+// which begins with `what`.
 void requireMemoryForBand(double area, double voxelSize, double halfWidth, double bytesPerVoxel,
-                          bool force);
+                          bool force, const std::string& what = "the start shape");
 
 } // namespace sweepers

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_file.h"
+#include "io/baked_tool.h"
 
 namespace sweepers {
 
@@ -23,7 +24,13 @@ namespace {
 // Walks the JSON tree and knows where it is, so every complaint carries its location.
 class Reader {
   public:
-    explicit Reader(const std::string& name) : name_(name) {}
+    explicit Reader(const std::string& name, const std::string& baseDir = "")
+        : name_(name), baseDir_(baseDir) {}
+
+    // Where the script's relative file names are taken from.
+    const std::string& baseDir() const { return baseDir_; }
+    // The script's voxel size, once /grid is read (a mesh tool's default sampling).
+    double voxelSize = GridSpec().voxelSize;
 
     [[noreturn]] void fail(const std::string& where, const std::string& why) const {
         throw ScriptError(name_ + ": " + (where.empty() ? "/" : where) + ": " + why);
@@ -79,6 +86,7 @@ class Reader {
 
   private:
     const std::string& name_;
+    const std::string& baseDir_;
 };
 
 Placement readPlacement(const Reader& r, const json& v, const std::string& at) {
@@ -108,12 +116,61 @@ Placement readPlacement(const Reader& r, const json& v, const std::string& at) {
     return p;
 }
 
+// {"vdb": file, "grid": name} or {"mesh": file, "voxel_size": h}.
+BakedToolSource readBakedSource(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"vdb", "mesh", "grid", "voxel_size"});
+    BakedToolSource b;
+    const bool vdb = v.contains("vdb");
+    if (vdb == v.contains("mesh")) r.fail(at, "expected exactly one of vdb, mesh");
+    b.kind = vdb ? BakedToolSource::Kind::Vdb : BakedToolSource::Kind::Mesh;
+    const std::string key = vdb ? "vdb" : "mesh";
+    b.file = r.string(v[key], at + "/" + key);
+    if (b.file.empty()) r.fail(at + "/" + key, "empty file name");
+    if (auto it = v.find("grid"); it != v.end()) {
+        if (!vdb) r.fail(at + "/grid", "names a grid of a VDB tool; this tool is a mesh");
+        b.gridName = r.string(*it, at + "/grid");
+        if (b.gridName.empty()) r.fail(at + "/grid", "empty grid name");
+    }
+    if (auto it = v.find("voxel_size"); it != v.end()) {
+        if (vdb) r.fail(at + "/voxel_size", "a VDB tool keeps its own voxel size");
+        b.voxelSize = r.positive(*it, at + "/voxel_size");
+    }
+    return b;
+}
+
+// Reads the baked tool's file: after its path, whose scales bound the band it needs.
+void loadTool(const Reader& r, ToolSpec& t, const std::string& at) {
+    double smallest = t.size.x(), largest = t.size.x();
+    for (std::size_t i = 0; i < t.path.size(); ++i) {
+        const Placement& p = t.path[i];
+        if (!p.uniformScale())
+            r.fail(at + "/path/" + std::to_string(i) + "/s",
+                   "a baked tool can only be scaled uniformly");
+        smallest = std::min(smallest, t.size.x() * p.scale.x());
+        largest = std::max(largest, t.size.x() * p.scale.x());
+    }
+    // A mesh is sampled at least as finely as the sculpt, wherever the tool is largest.
+    if (t.source.kind == BakedToolSource::Kind::Mesh && t.source.voxelSize == 0.0)
+        t.source.voxelSize = r.voxelSize / largest;
+    try {
+        t.baked = loadBakedTool(t.source, r.baseDir(), t.size.x(), t.falloff / smallest);
+    } catch (const std::exception& e) {
+        r.fail(at + "/shape", e.what());
+    }
+}
+
 ToolSpec readTool(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, {"shape", "size", "falloff", "path"});
     ToolSpec t;
-    const std::string shape = r.string(r.require(v, at, "shape"), at + "/shape");
+    const json& shapeValue = r.require(v, at, "shape");
+    const std::string shape =
+        shapeValue.is_object() ? "baked" : r.string(shapeValue, at + "/shape");
     const json& size = r.require(v, at, "size");
-    if (shape == "ball") {
+    if (shape == "baked") {
+        t.shape = ToolShapeKind::Baked;
+        t.source = readBakedSource(r, shapeValue, at + "/shape");
+        t.size = Eigen::Vector3d::Constant(r.positive(size, at + "/size"));
+    } else if (shape == "ball") {
         t.shape = ToolShapeKind::Ball;
         t.size = Eigen::Vector3d::Constant(r.positive(size, at + "/size"));
     } else if (shape == "ellipsoid") {
@@ -122,7 +179,9 @@ ToolSpec readTool(const Reader& r, const json& v, const std::string& at) {
         for (int i = 0; i < 3; ++i)
             if (!(t.size[i] > 0.0)) r.fail(at + "/size/" + std::to_string(i), "must be positive");
     } else {
-        r.fail(at + "/shape", "unknown shape \"" + shape + "\" (expected ball or ellipsoid)");
+        r.fail(at + "/shape", "unknown shape \"" + shape +
+                                  "\" (expected ball, ellipsoid, {\"vdb\": file} or "
+                                  "{\"mesh\": file})");
     }
     t.falloff = r.positive(r.require(v, at, "falloff"), at + "/falloff");
     const json& path = r.require(v, at, "path");
@@ -130,6 +189,7 @@ ToolSpec readTool(const Reader& r, const json& v, const std::string& at) {
     if (path.size() < 2) r.fail(at + "/path", "a path needs at least two placements");
     for (std::size_t i = 0; i < path.size(); ++i)
         t.path.push_back(readPlacement(r, path[i], at + "/path/" + std::to_string(i)));
+    if (t.shape == ToolShapeKind::Baked) loadTool(r, t, at);
     return t;
 }
 
@@ -286,6 +346,14 @@ json placementJson(const Placement& p) {
     return j;
 }
 
+json bakedSourceJson(const BakedToolSource& b) {
+    if (b.kind == BakedToolSource::Kind::Mesh)
+        return {{"mesh", b.file}, {"voxel_size", b.voxelSize}};
+    json j = {{"vdb", b.file}};
+    if (!b.gridName.empty()) j["grid"] = b.gridName;
+    return j;
+}
+
 template <typename Spec> json topologyToolJson(const char* type, const Spec& s) {
     return {{"type", type},   {"at", vecJson(s.at)},  {"axis", vecJson(s.axis)},
             {"size", s.size}, {"falloff", s.falloff}, {"open", s.open}};
@@ -360,8 +428,9 @@ struct DuplicateKeys {
 
 } // namespace
 
-StrokeScript parseStrokeScript(const std::string& text, const std::string& name) {
-    const Reader r(name);
+StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
+                               const std::string& baseDir) {
+    Reader r(name, baseDir);
     json root;
     DuplicateKeys duplicates;
     try {
@@ -397,6 +466,7 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name)
         s.grid.halfWidthGiven = it->contains("half_width");
         if (s.grid.voxelSizeGiven)
             s.grid.voxelSize = r.positive((*it)["voxel_size"], "/grid/voxel_size");
+        r.voxelSize = s.grid.voxelSize;
         if (s.grid.halfWidthGiven) {
             s.grid.halfWidth = r.number((*it)["half_width"], "/grid/half_width");
             if (s.grid.halfWidth < 1.0 || s.grid.halfWidth > 64.0)
@@ -434,7 +504,7 @@ StrokeScript readStrokeScript(const std::string& path) {
     std::ostringstream ss;
     ss << in.rdbuf();
     if (in.bad()) throw ScriptError(path + ": cannot read the file");
-    return parseStrokeScript(ss.str(), path);
+    return parseStrokeScript(ss.str(), path, directoryOf(path));
 }
 
 std::string formatStrokeScript(const StrokeScript& s, int indent) {
@@ -463,12 +533,20 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             json tools = json::array();
             for (const ToolSpec& t : sw->tools) {
                 json tj;
-                const bool ball = t.shape == ToolShapeKind::Ball;
-                tj["shape"] = ball ? "ball" : "ellipsoid";
-                if (ball)
+                switch (t.shape) {
+                case ToolShapeKind::Ball:
+                    tj["shape"] = "ball";
                     tj["size"] = t.size.x();
-                else
+                    break;
+                case ToolShapeKind::Ellipsoid:
+                    tj["shape"] = "ellipsoid";
                     tj["size"] = vecJson(t.size);
+                    break;
+                case ToolShapeKind::Baked:
+                    tj["shape"] = bakedSourceJson(t.source);
+                    tj["size"] = t.size.x();
+                    break;
+                }
                 tj["falloff"] = t.falloff;
                 json path = json::array();
                 for (const Placement& p : t.path)
@@ -500,10 +578,16 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
     return indent < 0 ? root.dump() : root.dump(indent) + "\n";
 }
 
-StrokeScript withAbsoluteStart(StrokeScript s, const std::string& scriptDir) {
-    if (s.start.kind != StartShape::Kind::Sphere && !s.start.file.empty() &&
-        s.start.file.front() != '/')
-        s.start.file = std::filesystem::absolute(scriptDir + "/" + s.start.file).string();
+StrokeScript withAbsoluteFiles(StrokeScript s, const std::string& scriptDir) {
+    auto absolute = [&](std::string& file) {
+        if (!file.empty() && file.front() != '/')
+            file = std::filesystem::absolute(resolveAgainst(file, scriptDir)).string();
+    };
+    if (s.start.kind != StartShape::Kind::Sphere) absolute(s.start.file);
+    for (Stroke& stroke : s.strokes)
+        if (auto* sweep = std::get_if<SweepStroke>(&stroke))
+            for (ToolSpec& t : sweep->tools)
+                if (t.shape == ToolShapeKind::Baked) absolute(t.source.file);
     return s;
 }
 

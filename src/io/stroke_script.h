@@ -5,6 +5,7 @@
 //     "grid":  { "voxel_size": 0.02, "half_width": 3 },
 //     "start": { "sphere": { "center": [0,0,0], "radius": 1 } }   | {"vdb": F} | {"mesh": F}
 //     "strokes": [ { "type": "sweep", "mirror": "x", "tools": [ {shape, size, falloff, path} ] },
+//                  (shape: "ball" | "ellipsoid" | {"vdb": F, "grid": N} | {"mesh": F})
 //                  { "type": "swirl", "at": [..], "move": [..], "radius": r,
 //                    "ring": "discrete" | "convolution", "swirls": 8, "ball": rho },
 //                  { "type": "inflate", "at": [..], "radius": rho } ] }
@@ -27,16 +28,20 @@ class ScriptError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// Parse and validate; `name` is used in messages (usually the file path).
-StrokeScript parseStrokeScript(const std::string& text, const std::string& name);
-// Read a file; a missing or unreadable file is a ScriptError too.
+// Parse and validate; `name` is used in messages (usually the file path). Baked tools'
+// files are read (relative names from `baseDir`, "" for the current directory), and a tool
+// that cannot be made refuses the script like any other mistake.
+StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
+                               const std::string& baseDir = "");
+// Read a file (its baked tools relative to it); a missing or unreadable file is a
+// ScriptError too.
 StrokeScript readStrokeScript(const std::string& path);
 // Serialize (numbers round-trip exactly): pretty-printed with `indent` spaces and a final
 // line break, or on one line without a line break when indent < 0.
 std::string formatStrokeScript(const StrokeScript& script, int indent = 2);
-// The same script with its start file named absolutely (relative names are taken from
-// `scriptDir`), so that it works wherever it is saved.
-StrokeScript withAbsoluteStart(StrokeScript script, const std::string& scriptDir);
+// The same script with its start and tool files named absolutely (relative names are taken
+// from `scriptDir`), so that it works wherever it is saved.
+StrokeScript withAbsoluteFiles(StrokeScript script, const std::string& scriptDir);
 // Write atomically: temporary file beside the target, flush, rename.
 void writeStrokeScript(const StrokeScript& script, const std::string& path);
 

@@ -1,5 +1,7 @@
 #include "sculpt/stroke.h"
 
+#include <stdexcept>
+
 #include "deform/inflate.h"
 #include "levelset/band.h"
 #include "tools/ellipsoid.h"
@@ -16,8 +18,19 @@ Sweep toSweep(const SweepStroke& stroke) {
     sweep.mirror = stroke.mirror;
     for (const ToolSpec& t : stroke.tools) {
         SweptTool st;
-        st.shape = t.shape == ToolShapeKind::Ball ? std::make_shared<EllipsoidShape>(t.size.x())
-                                                  : std::make_shared<EllipsoidShape>(t.size);
+        switch (t.shape) {
+        case ToolShapeKind::Ball:
+            st.shape = std::make_shared<EllipsoidShape>(t.size.x());
+            break;
+        case ToolShapeKind::Ellipsoid:
+            st.shape = std::make_shared<EllipsoidShape>(t.size);
+            break;
+        case ToolShapeKind::Baked:
+            if (!t.baked)
+                throw std::invalid_argument("the baked tool " + t.source.file + " was not loaded");
+            st.shape = t.baked;
+            break;
+        }
         st.falloff = t.falloff;
         st.path = t.path;
         sweep.tools.push_back(std::move(st));

@@ -2,7 +2,8 @@
 // the modeler's drags (app/) both produce these; planStroke is the one place where a
 // stroke kind becomes deformations.
 //
-//   sweep   - tools (balls or ellipsoids) moved along paths of placements (thesis 3.3)
+//   sweep   - tools (balls, ellipsoids or baked shapes) moved along paths of placements
+//             (thesis 3.3, 3.4.3)
 //   swirl   - a ring of swirls carrying clay while keeping its volume (4.1-4.19)
 //   inflate - Decaudin's inflation adding a ball of material (2.30)
 //   pinch   - two needles poke a hole through the shape, then pull it open (3.5.1)
@@ -44,13 +45,28 @@ struct StartShape {
     std::string gridName; // of a VDB start: the level set to take (empty: the first usable)
 };
 
-enum class ToolShapeKind { Ball, Ellipsoid };
+enum class ToolShapeKind { Ball, Ellipsoid, Baked };
+
+// Where a baked tool (3.4.3) comes from: a level set in a .vdb file or a closed mesh.
+struct BakedToolSource {
+    enum class Kind { Vdb, Mesh };
+    Kind kind = Kind::Vdb;
+    std::string file;       // as written in the script (relative to it)
+    std::string gridName;   // of a .vdb: the level set to take (empty: the first usable)
+    double voxelSize = 0.0; // of a mesh: the sampling of its distance, in its own units
+};
 
 struct ToolSpec {
     ToolShapeKind shape = ToolShapeKind::Ball;
-    Eigen::Vector3d size = Eigen::Vector3d::Constant(0.3); // ball: all three equal
+    // Ball: the radius, three times. Ellipsoid: the semi-axes. Baked: the uniform scale,
+    // three times.
+    Eigen::Vector3d size = Eigen::Vector3d::Constant(0.3);
     double falloff = 0.3;
     std::vector<Placement> path;
+    BakedToolSource source;
+    // A baked tool's shape at its size, as loaded by io/ (the file is read when the script
+    // is, so every run of a script, at any voxel size, sculpts with the same tool).
+    std::shared_ptr<const ToolShape> baked;
 };
 
 struct SweepStroke {
@@ -84,7 +100,8 @@ struct StrokeScript {
     std::vector<Stroke> strokes;
 };
 
-// The deformation a sweep stroke describes.
+// The deformation a sweep stroke describes. Throws std::invalid_argument for a baked tool
+// that was not loaded.
 Sweep toSweep(const SweepStroke& stroke);
 // The swirl ring a swirl stroke describes.
 SwirlSpec toSwirl(const SwirlStroke& stroke);

@@ -1,6 +1,7 @@
 #include "tools/tool_shape.h"
 
 #include <stdexcept>
+#include <string>
 
 #include "core/falloff.h"
 
@@ -9,6 +10,10 @@ namespace sweepers {
 PlacedTool::PlacedTool(std::unique_ptr<PlacedShape> shape, double falloff)
     : shape_(std::move(shape)), falloff_(falloff) {
     if (!(falloff > 0.0)) throw std::invalid_argument("a tool's falloff must be positive");
+    if (falloff > shape_->exactBelow() * (1.0 + 1e-9))
+        throw std::invalid_argument("the falloff " + std::to_string(falloff) +
+                                    " reaches past the tool's distance band (" +
+                                    std::to_string(shape_->exactBelow()) + ")");
     coating_ = shape_->bounds().expanded(falloff);
 }
 

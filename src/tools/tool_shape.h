@@ -7,6 +7,7 @@
 // implements the same two classes.
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -30,6 +31,13 @@ class PlacedShape {
     }
     // World box enclosing the shape.
     virtual Box bounds() const = 0;
+    // A bound on |grad distance|. An exact distance has 1; a sampled one (a baked tool)
+    // can be steeper between its samples, and the fold-over bound (3.14, 3.19) and the
+    // reach tests scale by it.
+    virtual double lipschitz() const { return 1.0; }
+    // distanceBelow is exact below this world distance (a sampled distance is exact only
+    // within the band it was built with); a falloff wider than it is refused.
+    virtual double exactBelow() const { return std::numeric_limits<double>::infinity(); }
 };
 
 class ToolShape {
@@ -44,6 +52,8 @@ class ToolShape {
 // thickness lambda, 0 outside.
 class PlacedTool {
   public:
+    // Throws std::invalid_argument for a falloff that is not positive or that reaches
+    // past where the shape's distance is known.
     PlacedTool(std::unique_ptr<PlacedShape> shape, double falloff);
 
     double influence(const Eigen::Vector3d& p) const;
@@ -51,6 +61,7 @@ class PlacedTool {
     // Box enclosing the tool and its coating: outside it the influence is exactly 0.
     const Box& coatingBounds() const { return coating_; }
     double falloff() const { return falloff_; }
+    double lipschitz() const { return shape_->lipschitz(); }
 
   private:
     std::unique_ptr<PlacedShape> shape_;

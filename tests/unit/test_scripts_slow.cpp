@@ -91,8 +91,8 @@ TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Data, DataScript,
-                         ::testing::Values("drag", "horn", "mirrored_ears", "pinch", "pinch_torus",
-                                           "pull", "severed_horn", "starfish_swirls",
+                         ::testing::Values("drag", "finger", "horn", "mirrored_ears", "pinch",
+                                           "pinch_torus", "pull", "severed_horn", "starfish_swirls",
                                            "strangle_torus", "twisted_limb", "two_handles"),
                          [](const auto& info) { return std::string(info.param); });
 
@@ -101,7 +101,7 @@ TEST(DataScripts, EveryScriptInDataIsCovered) {
     std::size_t scripts = 0;
     for (const auto& entry : std::filesystem::directory_iterator(SWEEPERS_DATA_DIR))
         scripts += entry.path().extension() == ".json";
-    EXPECT_EQ(scripts, 11u);
+    EXPECT_EQ(scripts, 12u);
 }
 
 TEST(Advect, PinchOpensAHole) {
