@@ -135,6 +135,14 @@ GlRenderer::GlRenderer(const std::string& shaderDir) {
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(g.size() * sizeof(float)), g.data(), GL_STATIC_DRAW);
     glEnableVertexAttribArray(0);
     glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
+
+    // The preview's lines: filled at every draw.
+    glGenVertexArrays(1, &lines_.vao);
+    glBindVertexArray(lines_.vao);
+    glGenBuffers(1, &lines_.vbo);
+    glBindBuffer(GL_ARRAY_BUFFER, lines_.vbo);
+    glEnableVertexAttribArray(0);
+    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 3 * sizeof(float), nullptr);
     glBindVertexArray(0);
 }
 
@@ -143,6 +151,7 @@ GlRenderer::~GlRenderer() {
         releaseBrick(m);
     releaseBrick(sphere_);
     releaseBrick(grid_);
+    releaseBrick(lines_);
     glDeleteProgram(clay_);
     glDeleteProgram(flat_);
 }
@@ -285,6 +294,18 @@ void GlRenderer::draw(const glm::dmat4& view, const glm::dmat4& projection, bool
         }
         glDepthMask(GL_TRUE);
         glDisable(GL_BLEND);
+    }
+    // The preview, over everything: the far needle and the back of a circle matter too.
+    if (!tool.lines.empty()) {
+        glDisable(GL_DEPTH_TEST);
+        glUniformMatrix4fv(model, 1, GL_FALSE, glm::value_ptr(glm::mat4(1.0f)));
+        glUniform4f(tint, 1.0f, 0.78f, 0.2f, 1.0f);
+        glBindVertexArray(lines_.vao);
+        glBindBuffer(GL_ARRAY_BUFFER, lines_.vbo);
+        glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(tool.lines.size() * sizeof(glm::vec3)),
+                     tool.lines.data(), GL_STREAM_DRAW);
+        glDrawArrays(GL_LINES, 0, GLsizei(tool.lines.size()));
+        glEnable(GL_DEPTH_TEST);
     }
     glBindVertexArray(0);
 }

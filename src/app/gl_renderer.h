@@ -1,10 +1,11 @@
 // Draws a document with OpenGL 3.3 core: the clay surface in bricks of 4^3 leaves (only
 // bricks whose chunks changed are re-uploaded), an optional wireframe, the ground grid,
-// and the tool with its coating as translucent shells.
+// the tool with its coating as translucent shells, and the lines of a stroke's preview.
 #pragma once
 
 #include <map>
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -16,6 +17,9 @@ struct ToolOverlay {
     bool visible = false;
     glm::dvec3 center{0.0};
     double radius = 0.25, falloff = 0.25;
+    // Line segments (pairs of ends) drawn over the shape: the preview of a pinch or a
+    // strangle.
+    std::vector<glm::vec3> lines;
 };
 
 class GlRenderer {
@@ -44,7 +48,7 @@ class GlRenderer {
 
     unsigned clay_ = 0, flat_ = 0;
     std::map<openvdb::Coord, GpuMesh> bricks_;
-    GpuMesh sphere_, grid_;
+    GpuMesh sphere_, grid_, lines_;
     int gridLines_ = 0;
     std::size_t lastUploads_ = 0;
 };

@@ -382,6 +382,9 @@ class Modeler {
             tool.visible = true;
             tool.center = *centre;
         }
+        if (const auto stroke = ctl_.topologyStroke())
+            for (const glm::dvec3& p : strokePreview(*stroke))
+                tool.lines.emplace_back(p);
         const OrbitCamera& camera = ctl_.camera();
         renderer_->draw(camera.view(), camera.projection(double(fw) / std::max(fh, 1)), s.wireframe,
                         tool, groundY_);
@@ -438,8 +441,22 @@ class Modeler {
         ImGui::RadioButton("Swirl, keeps volume (S)", &m, 3);
         ImGui::SameLine();
         ImGui::RadioButton("Add clay (C)", &m, 4);
+        ImGui::RadioButton("Pinch a hole (P)", &m, 5);
+        ImGui::SameLine();
+        ImGui::RadioButton("Strangle (K)", &m, 6);
         s.mode = SculptMode(m);
         ImGui::EndDisabled();
+        if (s.mode == SculptMode::Pinch)
+            ImGui::TextWrapped("Drag from the surface: the hole goes through along the view, "
+                               "the drag sets its radius; release to pinch.");
+        else if (s.mode == SculptMode::Strangle)
+            ImGui::TextWrapped("Drag across a limb: the drag sets the circle's radius, the "
+                               "radius below the gap; release to strangle.");
+        if (s.bakedTool) {
+            ImGui::Text("tool: %s", s.bakedSource.file.c_str());
+            ImGui::SameLine();
+            if (ImGui::Button("Ball")) ctl_.useBall();
+        }
         float r = float(s.radius), f = float(s.falloff);
         if (ImGui::SliderFloat("radius  [ ]", &r, 0.02f, 1.0f, "%.3f",
                                ImGuiSliderFlags_Logarithmic))
@@ -470,6 +487,15 @@ class Modeler {
         ImGui::Separator();
         ImGui::InputText("file", path_, sizeof path_);
         if (ImGui::Button("Open")) openFile(path_);
+        ImGui::SameLine();
+        if (ImGui::Button("Tool from file")) {
+            try {
+                ctl_.useToolFile(path_);
+                status_ = std::string("grab and twist with ") + path_;
+            } catch (const std::exception& e) {
+                fail(e.what());
+            }
+        }
         ImGui::SameLine();
         if (ImGui::Button("Save")) save(path_);
         ImGui::SameLine();

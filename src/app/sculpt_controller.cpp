@@ -3,10 +3,13 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <filesystem>
 
 #define GLFW_INCLUDE_NONE // key codes only: this file uses no window
 #include <GLFW/glfw3.h>
 
+#include "io/baked_tool.h"
+#include "io/mesh_file.h"
 #include "levelset/band.h"
 #include "levelset/raycast.h"
 
@@ -73,6 +76,10 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
     drag_ = DragKind::Sculpt;
     pending_ = false;
     stop_.reset();
+    if (topologyMode()) {
+        beginTopologyDrag();
+        return;
+    }
     if (settings_.mode == SculptMode::Swirl || settings_.mode == SculptMode::Clay) {
         doc_->beginEdit();
         if (settings_.mode == SculptMode::Clay) {
@@ -86,7 +93,108 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
     tool.size = Eigen::Vector3d::Constant(settings_.radius);
     tool.falloff = settings_.falloff;
     tool.path = {last_};
+    if (settings_.bakedTool && settings_.mode != SculptMode::Inflate) {
+        // The baked tool at the size the radius asks (its own half-size is 1), with a band
+        // for this falloff (loaded again only when the falloff outgrows the last band).
+        tool.shape = ToolShapeKind::Baked;
+        tool.source = settings_.bakedSource;
+        tool.size = Eigen::Vector3d::Constant(settings_.radius / settings_.bakedRadius);
+        try {
+            tool.baked =
+                loadBakedTool(tool.source, "", tool.size.x(), tool.falloff / tool.size.x());
+        } catch (const std::exception& e) {
+            message_ = e.what();
+            drag_ = DragKind::None;
+            return;
+        }
+    }
     doc_->beginStroke(tool, settings_.mirror);
+}
+
+void SculptController::useToolFile(const std::string& path) {
+    BakedToolSource source;
+    source.kind = isMeshPath(path) ? BakedToolSource::Kind::Mesh : BakedToolSource::Kind::Vdb;
+    source.file = std::filesystem::absolute(path).lexically_normal().string();
+    if (source.kind == BakedToolSource::Kind::Mesh && doc_)
+        source.voxelSize = doc_->grid().voxelSize()[0];
+    const auto shape = loadBakedTool(source, "", 1.0, settings_.falloff);
+    const Box b = shape->place(Eigen::Affine3d::Identity())->bounds();
+    settings_.bakedTool = shape;
+    settings_.bakedSource = source;
+    settings_.bakedRadius = 0.5 * b.extent().maxCoeff();
+}
+
+void SculptController::useBall() {
+    settings_.bakedTool.reset();
+}
+
+// Pinch and strangle: the press finds where the view ray leaves the shape again; the
+// stroke is set up between the two sides.
+void SculptController::beginTopologyDrag() {
+    const glm::dvec3 dir = glm::normalize(grab_ - camera_.eye());
+    const auto out =
+        exitLevelSet(doc_->grid(), toEigen3(grab_), toEigen3(dir), 1e3 * camera_.distance);
+    if (!out) {
+        message_ = "the view ray does not come out of the shape there";
+        drag_ = DragKind::None;
+        return;
+    }
+    through_ = 0.5 * (grab_ + toGlm(*out));
+    depth_ = glm::length(toGlm(*out) - grab_);
+    axis_ = dir;
+    applied_ = false;
+}
+
+std::optional<Stroke> SculptController::topologyStroke() const {
+    if (!doc_ || drag_ != DragKind::Sculpt || !topologyMode()) return std::nullopt;
+    const glm::dvec3 w =
+        camera_.dragInViewPlane(grab_, pressX_, pressY_, cursorX_, cursorY_, width_, height_);
+    const double h = doc_->grid().voxelSize()[0], f = settings_.falloff;
+    if (settings_.mode == SculptMode::Pinch) {
+        // The tips start half a falloff outside both sides; the drag opens the hole. The
+        // needles' funnels are as thin as their falloff allows: below about 13 voxels the
+        // grid loses them on axes off its own (measured on a unit sphere at 1/32: a plug
+        // stays for 10 voxels along (1, 1, 1), not for 12.8), so the falloff is at least 16.
+        PinchStroke s;
+        const double falloff = std::max(f, kMinPinchFalloffVoxels * h);
+        s.at = toEigen3(through_);
+        s.axis = toEigen3(axis_);
+        s.size = 0.5 * depth_ + 0.5 * falloff;
+        s.falloff = falloff;
+        s.open = std::max(glm::length(w), 2.0 * h);
+        return s;
+    }
+    // The drag goes across the limb: its length is the circle's radius, and with the view
+    // ray it spans the circle's plane.
+    if (glm::length(w) < 2.0 * h) return std::nullopt;
+    StrangleStroke s;
+    s.at = toEigen3(through_);
+    s.axis = toEigen3(glm::normalize(glm::cross(w, axis_)));
+    s.size = glm::length(w);
+    s.falloff = f;
+    s.open = settings_.radius;
+    return s;
+}
+
+void SculptController::stepTopologyDrag() {
+    pending_ = false; // the preview follows the cursor by itself
+    if (!releasing_) return;
+    if (applied_) {
+        finishDrag(); // its work is done
+        return;
+    }
+    const std::optional<Stroke> stroke = topologyStroke();
+    if (!stroke) {
+        message_ = "drag across the limb: the drag's length is the strangling circle's radius";
+        drag_ = DragKind::None;
+        releasing_ = false;
+        return;
+    }
+    applied_ = true;
+    doc_->beginEdit();
+    Document* doc = doc_;
+    pendingSince_ = Clock::now();
+    launch([doc, st = *stroke] { return doc->applyStroke(st); });
 }
 
 // Clay mode: one inflation of the tool's radius (2.30) centred half a radius under the
@@ -164,6 +272,12 @@ KeyAction SculptController::onKey(int key, bool ctrl, bool shift) {
     case 'I':
         settings_.mode = SculptMode::Inflate;
         break;
+    case 'P':
+        settings_.mode = SculptMode::Pinch;
+        break;
+    case 'K':
+        settings_.mode = SculptMode::Strangle;
+        break;
     case 'F':
         if (!busy()) frameView();
         break;
@@ -235,7 +349,7 @@ std::optional<glm::dvec3> SculptController::pick(double x, double y) const {
 
 std::optional<glm::dvec3> SculptController::toolCentre() const {
     if (drag_ == DragKind::Sculpt) {
-        if (settings_.mode == SculptMode::Clay) return std::nullopt;
+        if (settings_.mode == SculptMode::Clay || topologyMode()) return std::nullopt;
         return toGlm(last_.t);
     }
     if (drag_ == DragKind::None && !busy()) return pick(cursorX_, cursorY_);
@@ -257,6 +371,8 @@ Placement SculptController::placementAt(double x, double y) const {
     case SculptMode::Grab:
     case SculptMode::Swirl:
     case SculptMode::Clay:
+    case SculptMode::Pinch:
+    case SculptMode::Strangle:
         p.t = toEigen3(grab_ +
                        camera_.dragInViewPlane(grab_, pressX_, pressY_, x, y, width_, height_));
         break;
@@ -325,6 +441,10 @@ void SculptController::finishDrag() {
 void SculptController::step() {
     collect();
     if (busy() || drag_ != DragKind::Sculpt) return;
+    if (topologyMode()) {
+        stepTopologyDrag();
+        return;
+    }
     if (pending_) {
         pending_ = false;
         Document* doc = doc_;
@@ -361,6 +481,38 @@ void SculptController::step() {
         }
     }
     if (releasing_) finishDrag();
+}
+
+namespace {
+
+// A circle of radius r about c in the plane normal to n, as 48 segments.
+void addCircle(std::vector<glm::dvec3>& lines, const glm::dvec3& c, const glm::dvec3& n, double r) {
+    const glm::dvec3 a = glm::normalize(
+        glm::cross(n, std::abs(n.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0)));
+    const glm::dvec3 b = glm::cross(n, a);
+    const int segments = 48;
+    for (int i = 0; i < segments; ++i)
+        for (int k : {i, i + 1}) {
+            const double t = 2.0 * M_PI * k / segments;
+            lines.push_back(c + r * (std::cos(t) * a + std::sin(t) * b));
+        }
+}
+
+} // namespace
+
+std::vector<glm::dvec3> strokePreview(const Stroke& stroke) {
+    std::vector<glm::dvec3> lines;
+    if (const auto* p = std::get_if<PinchStroke>(&stroke)) {
+        const glm::dvec3 at = toGlm(p->at), axis = glm::normalize(toGlm(p->axis));
+        for (double side : {1.0, -1.0})
+            lines.insert(lines.end(), {at + side * p->size * axis, at});
+        addCircle(lines, at, axis, p->open);
+    } else if (const auto* s = std::get_if<StrangleStroke>(&stroke)) {
+        const glm::dvec3 at = toGlm(s->at), axis = glm::normalize(toGlm(s->axis));
+        addCircle(lines, at, axis, s->size);
+        lines.insert(lines.end(), {at - 0.5 * s->open * axis, at + 0.5 * s->open * axis});
+    }
+    return lines;
 }
 
 ReplayClock::ReplayClock(std::vector<InputEvent> events)

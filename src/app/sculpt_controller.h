@@ -9,6 +9,7 @@
 #include <chrono>
 #include <functional>
 #include <future>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -25,8 +26,9 @@ namespace sweepers {
 
 // Grab, twist and inflate are sweeps (one segment per piece); swirl moves clay while
 // keeping its volume (one swirl ring per piece, 4.1); clay adds material (Decaudin's
-// inflation, 2.30) under the cursor.
-enum class SculptMode { Grab, Twist, Inflate, Swirl, Clay };
+// inflation, 2.30) under the cursor. Pinch and strangle change the topology (3.5): a drag
+// sets them up, shown as a preview, and the release applies the whole stroke.
+enum class SculptMode { Grab, Twist, Inflate, Swirl, Clay, Pinch, Strangle };
 enum class DragKind { None, Sculpt, Orbit, Pan };
 
 struct ToolSettings {
@@ -34,6 +36,11 @@ struct ToolSettings {
     MirrorAxis mirror = MirrorAxis::None;
     double radius = 0.25, falloff = 0.25;
     bool wireframe = false;
+    // Grab and twist move this shape instead of a ball when set (a baked tool, 3.4.3),
+    // scaled by `radius` over its own half-size `bakedRadius`.
+    std::shared_ptr<const ToolShape> bakedTool;
+    BakedToolSource bakedSource;
+    double bakedRadius = 1.0;
 };
 
 // What a key asks of the window beyond the controller's own state.
@@ -45,6 +52,8 @@ class SculptController {
     // turns the way the hand went, however fast it went (a segment's motion is the
     // logarithm of the relative placement, which takes the short way round).
     static constexpr double kMaxTwistStepDegrees = 60.0;
+    // A pinch's falloff is at least this many voxels (see topologyStroke).
+    static constexpr double kMinPinchFalloffVoxels = 16.0;
 
     // waitEachPiece: every piece of sculpting is finished before the next event is taken
     // (replays and tests: deterministic); otherwise events coalesce while one runs.
@@ -87,6 +96,13 @@ class SculptController {
     std::optional<glm::dvec3> toolCentre() const;
     // The surface point under a window pixel.
     std::optional<glm::dvec3> pick(double x, double y) const;
+    // During a pinch or strangle drag: the stroke the release will apply, as it stands.
+    std::optional<Stroke> topologyStroke() const;
+    // Grab and twist with the shape of a .vdb level set or a closed mesh (a mesh is sampled
+    // at the document's voxel size); throws saying why a file cannot be a tool.
+    void useToolFile(const std::string& path);
+    // Back to the ball.
+    void useBall();
     // Looks at the whole shape.
     void frameView();
     double volume() const { return volume_; }
@@ -108,6 +124,11 @@ class SculptController {
     void collect();
     void dab(const glm::dvec3& p);
     void finishDrag();
+    bool topologyMode() const {
+        return settings_.mode == SculptMode::Pinch || settings_.mode == SculptMode::Strangle;
+    }
+    void beginTopologyDrag();
+    void stepTopologyDrag();
 
     Document* doc_ = nullptr;
     bool waitEach_ = false;
@@ -118,6 +139,10 @@ class SculptController {
     bool pending_ = false, releasing_ = false;
     double pressX_ = 0, pressY_ = 0, lastX_ = 0, lastY_ = 0, cursorX_ = -1, cursorY_ = -1;
     glm::dvec3 grab_{0.0}, axis_{0, 0, 1}, lastDab_{0.0};
+    // Pinch and strangle: the middle of the shape along the view ray, and its depth there.
+    glm::dvec3 through_{0.0};
+    double depth_ = 0.0;
+    bool applied_ = false;
     double dabX_ = 0, dabY_ = 0;
     Placement last_;
     Clock::time_point pendingSince_, workSince_;
@@ -127,6 +152,11 @@ class SculptController {
     std::string message_;
     double volume_ = 0.0;
 };
+
+// What the modeler draws of a pinch or a strangle before it is applied, as line segments
+// (pairs of ends): the needles from their start to where they meet and the circle of the
+// hole; the strangling circle, its axis and the gap. Empty for other strokes.
+std::vector<glm::dvec3> strokePreview(const Stroke& stroke);
 
 // Hands recorded events over frame by frame, as the modeler's loop and replayEvents both do:
 // a frame's events go out only when the controller takes events (see waitEachPiece), and

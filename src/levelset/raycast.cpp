@@ -4,15 +4,19 @@
 
 namespace sweepers {
 
-std::optional<Eigen::Vector3d> raycastLevelSet(const Grid& grid, const Eigen::Vector3d& origin,
-                                               const Eigen::Vector3d& direction,
-                                               double maxDistance) {
+namespace {
+
+// The first point along the ray where phi * sign crosses to negative (sign +1: from
+// outside in; -1: from inside out).
+std::optional<Eigen::Vector3d> march(const Grid& grid, const Eigen::Vector3d& origin,
+                                     const Eigen::Vector3d& direction, double maxDistance,
+                                     double sign) {
     const Eigen::Vector3d d = direction.normalized();
     const double h = grid.voxelSize()[0];
     const Grid::ConstAccessor acc = grid.getConstAccessor(); // the sampler keeps a reference
     const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
         acc, grid.transform());
-    auto phi = [&](double t) { return double(sampler.wsSample(toVdb(origin + t * d))); };
+    auto phi = [&](double t) { return sign * double(sampler.wsSample(toVdb(origin + t * d))); };
     // Start where the ray enters the box of the active voxels (plus the band).
     const openvdb::CoordBBox ibox = grid.evalActiveVoxelBoundingBox();
     if (ibox.empty()) return std::nullopt;
@@ -30,7 +34,7 @@ std::optional<Eigen::Vector3d> raycastLevelSet(const Grid& grid, const Eigen::Ve
     }
     if (t0 > t1) return std::nullopt;
     double t = t0, v = phi(t);
-    if (v < 0) return origin + t * d; // starts inside
+    if (v < 0) return sign > 0 ? std::optional(Eigen::Vector3d(origin + t * d)) : std::nullopt;
     while (t < t1) {
         const double step = std::max(0.9 * v, 0.5 * h);
         const double tn = std::min(t + step, t1);
@@ -48,6 +52,19 @@ std::optional<Eigen::Vector3d> raycastLevelSet(const Grid& grid, const Eigen::Ve
         v = vn;
     }
     return std::nullopt;
+}
+
+} // namespace
+
+std::optional<Eigen::Vector3d> raycastLevelSet(const Grid& grid, const Eigen::Vector3d& origin,
+                                               const Eigen::Vector3d& direction,
+                                               double maxDistance) {
+    return march(grid, origin, direction, maxDistance, 1.0);
+}
+
+std::optional<Eigen::Vector3d> exitLevelSet(const Grid& grid, const Eigen::Vector3d& inside,
+                                            const Eigen::Vector3d& direction, double maxDistance) {
+    return march(grid, inside, direction, maxDistance, -1.0);
 }
 
 } // namespace sweepers

@@ -1,4 +1,5 @@
-// Where a ray first meets the surface of a level set: what the modeler grabs.
+// Where a ray first meets the surface of a level set (what the modeler grabs), and where
+// it leaves the shape again (the far side a pinch goes through).
 #pragma once
 
 #include <optional>
@@ -12,5 +13,11 @@ namespace sweepers {
 std::optional<Eigen::Vector3d> raycastLevelSet(const Grid& grid, const Eigen::Vector3d& origin,
                                                const Eigen::Vector3d& direction,
                                                double maxDistance);
+
+// Where a ray from `inside` (a point of the shape) leaves the shape along `direction`: the
+// same march on the field's other side. Nothing when it does not leave within
+// `maxDistance`, or when `inside` is not inside.
+std::optional<Eigen::Vector3d> exitLevelSet(const Grid& grid, const Eigen::Vector3d& inside,
+                                            const Eigen::Vector3d& direction, double maxDistance);
 
 } // namespace sweepers

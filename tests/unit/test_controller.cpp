@@ -3,15 +3,19 @@
 // and the mesh as they were.
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
 
 #include "app/sculpt_controller.h"
 #include "grids.h"
 #include "io/stroke_script.h"
+#include "io/vdb_file.h"
 #include "levelset/create.h"
 #include "levelset/fast_marching.h"
+#include "levelset/measure.h"
 #include "replay.h"
+#include "scratch_dir.h"
 
 using namespace sweepers;
 using sweepers::test::differingVoxels;
@@ -210,4 +214,133 @@ TEST(Cancel, EveryLongOperationStopsAndLeavesItsInputAsItWas) {
         StopAfter stop(5);
         EXPECT_THROW(Document::replayAt(script, ".", 1.0 / 48, {}, &stop), Cancelled);
     }
+}
+
+TEST(SculptController, PinchModeGoesThroughTheShapeAlongTheView) {
+    // P, a press on the middle of the sphere and a drag: the pinch's needles lie on the view
+    // ray through the press, on either side of the sphere, the drag sets the hole's radius,
+    // and the preview shows it all before the release applies it: a torus.
+    Session s;
+    s.ctl.onKey('P', false, false);
+    const double x0 = kWidth / 2.0, y0 = kHeight / 2.0;
+    s.ctl.onButton(0, true, x0, y0, false);
+    ASSERT_EQ(s.ctl.drag(), DragKind::Sculpt);
+    double x = x0, firstOpen = 0.0;
+    std::optional<Stroke> stroke;
+    for (; x < kWidth; x += 2) {
+        s.ctl.onMove(x, y0);
+        s.ctl.step();
+        stroke = s.ctl.topologyStroke();
+        ASSERT_TRUE(stroke);
+        if (x == x0) firstOpen = std::get<PinchStroke>(*stroke).open;
+        if (std::get<PinchStroke>(*stroke).open >= 0.3) break;
+    }
+    EXPECT_LT(firstOpen, 0.1); // the drag opens the hole
+    EXPECT_LT(x, kWidth);
+    const PinchStroke& pinch = std::get<PinchStroke>(*stroke);
+    const Eigen::Vector3d eye(s.ctl.camera().eye().x, s.ctl.camera().eye().y,
+                              s.ctl.camera().eye().z);
+    // The view ray through the middle of the window goes through the sphere's centre.
+    const double h = s.doc.grid().voxelSize()[0];
+    EXPECT_LT(pinch.at.norm(), h);
+    EXPECT_LT((pinch.axis.normalized() + eye.normalized()).norm(), 1e-6);
+    // At this coarse voxel size the falloff is raised to 16 voxels (0.25 asked).
+    EXPECT_EQ(pinch.falloff, SculptController::kMinPinchFalloffVoxels * h);
+    EXPECT_NEAR(pinch.size, 1.0 + 0.5 * pinch.falloff, h);
+    EXPECT_GE(strokePreview(*stroke).size(), 4u);
+    EXPECT_TRUE(s.doc.script().strokes.empty()); // nothing applied before the release
+    s.ctl.onButton(0, false, x, y0, false);
+    s.ctl.wait();
+    s.ctl.step();
+    EXPECT_EQ(s.ctl.drag(), DragKind::None);
+    EXPECT_EQ(s.ctl.takeMessage(), "");
+    ASSERT_EQ(s.doc.script().strokes.size(), 1u);
+    EXPECT_TRUE(std::holds_alternative<PinchStroke>(s.doc.script().strokes[0]));
+    EXPECT_EQ(topologicalEulerCharacteristic(s.doc.grid()), 0);
+    // One undo step.
+    s.doc.undo();
+    EXPECT_EQ(topologicalEulerCharacteristic(s.doc.grid()), 2);
+}
+
+TEST(SculptController, StrangleModeCutsAroundTheLimbUnderTheCursor) {
+    // K, a press on the middle of the sphere and a drag across it, past its outline: the
+    // circle lies in the plane of the drag and the view, around the sphere's centre, and the
+    // release cuts the sphere in two. A release without a drag says what to do instead.
+    Session s;
+    s.ctl.onKey('K', false, false);
+    const double x0 = kWidth / 2.0, y0 = kHeight / 2.0;
+    s.ctl.onButton(0, true, x0, y0, false);
+    s.ctl.onButton(0, false, x0, y0, false);
+    s.ctl.step();
+    EXPECT_NE(s.ctl.takeMessage().find("drag across the limb"), std::string::npos);
+    EXPECT_EQ(s.ctl.drag(), DragKind::None);
+    EXPECT_TRUE(s.doc.script().strokes.empty());
+
+    s.ctl.onButton(0, true, x0, y0, false);
+    double x = x0;
+    std::optional<Stroke> stroke;
+    for (; x < kWidth; x += 2) {
+        s.ctl.onMove(x, y0);
+        s.ctl.step();
+        stroke = s.ctl.topologyStroke();
+        if (stroke && std::get<StrangleStroke>(*stroke).size >= 1.15) break;
+    }
+    ASSERT_TRUE(stroke);
+    const StrangleStroke& strangle = std::get<StrangleStroke>(*stroke);
+    const double h = s.doc.grid().voxelSize()[0];
+    EXPECT_LT(strangle.at.norm(), h);
+    // A horizontal drag seen from the front: the circle is upright, its axis vertical in
+    // the view.
+    const Eigen::Vector3d eye(s.ctl.camera().eye().x, s.ctl.camera().eye().y,
+                              s.ctl.camera().eye().z);
+    EXPECT_LT(std::abs(strangle.axis.normalized().dot(eye.normalized())), 1e-6);
+    s.ctl.onButton(0, false, x, y0, false);
+    s.ctl.wait();
+    s.ctl.step();
+    EXPECT_EQ(s.ctl.takeMessage(), "");
+    ASSERT_EQ(s.doc.script().strokes.size(), 1u);
+    EXPECT_EQ(measureLevelSet(s.doc.grid()).components, 2u);
+}
+
+TEST(SculptController, AToolFromAFileGrabsAndIsRecordedByItsFile) {
+    // "Tool from file": grab drags move the file's shape; the recorded script names the
+    // file and replays to the same grid. A file that cannot be a tool is refused with its
+    // reason; "Ball" goes back to the ball.
+    sweepers::test::ScratchDir dir;
+    writeLevelSet(*makeSphere(Eigen::Vector3d::Zero(), 1.0, 1.0 / 16, 3.0), dir / "tool.vdb");
+    std::ofstream(dir / "broken.vdb") << "not a vdb";
+    Session s;
+    try {
+        s.ctl.useToolFile(dir / "broken.vdb");
+        ADD_FAILURE() << "a broken file was taken as a tool";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("broken.vdb"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(s.ctl.settings().bakedTool);
+    s.ctl.useToolFile(dir / "tool.vdb");
+    ASSERT_TRUE(s.ctl.settings().bakedTool);
+    const GridPtr before = s.doc.grid().deepCopy();
+    auto drag = [&] {
+        s.ctl.onButton(0, true, kWidth / 2.0, kHeight / 2.0, false);
+        for (int k = 1; k <= 3; ++k) {
+            s.ctl.onMove(kWidth / 2.0 + 10 * k, kHeight / 2.0 - 10 * k);
+            s.ctl.step();
+        }
+        s.ctl.onButton(0, false, kWidth / 2.0 + 30, kHeight / 2.0 - 30, false);
+        s.ctl.wait();
+        s.ctl.step();
+        ASSERT_EQ(s.ctl.takeMessage(), "");
+    };
+    drag();
+    EXPECT_GT(differingVoxels(*before, s.doc.grid()), 100u);
+    EXPECT_EQ(s.tool().shape, ToolShapeKind::Baked);
+    EXPECT_EQ(s.tool().source.file, std::filesystem::absolute(dir / "tool.vdb").string());
+    // Half the tool's extent is the radius.
+    const Box b = s.tool().baked->place(Eigen::Affine3d::Identity())->bounds();
+    EXPECT_NEAR(0.5 * b.extent().maxCoeff(), s.ctl.settings().radius, 1e-9);
+    s.ctl.useBall();
+    drag();
+    EXPECT_EQ(s.tool().shape, ToolShapeKind::Ball);
+    const StrokeScript recorded = parseStrokeScript(formatStrokeScript(s.doc.script()), "recorded");
+    EXPECT_EQ(differingVoxels(*applyScript(recorded, "."), s.doc.grid()), 0u);
 }
