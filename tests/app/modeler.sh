@@ -89,7 +89,8 @@ PY
 "$py" "$here/same_grid.py" "$tmp/swirl.vdb" "$tmp/swirl_replayed.vdb"
 
 # --- pinch mode (P): a press on the sphere and a drag poke a hole through it along the
-# view; the saved shape is a torus, and the recorded script replays to it
+# view; the saved shape is a torus (that the recorded script replays to it is checked
+# without a window, by SculptController.EveryReplayFileSculptsAndRecords...)
 run --replay-input "$here/pinch.json" --save "$tmp/pinch.vdb" --save-script "$tmp/pinch.json"
 "$cli" info --json "$tmp/pinch.vdb" >"$tmp/pinch.info"
 "$py" - "$tmp/pinch.info" "$tmp/pinch.json" <<'PY'
@@ -99,8 +100,6 @@ assert [s["type"] for s in script["strokes"]] == ["pinch"], script["strokes"]
 assert info["euler_characteristic"] == 0 and info["components"] == 1, info
 print(f"pinch: a torus (genus {info['genus']}), hole radius {script['strokes'][0]['open']:.3f}")
 PY
-"$cli" apply "$tmp/pinch.json" -o "$tmp/pinch_replayed.vdb" -q
-"$py" "$here/same_grid.py" "$tmp/pinch.vdb" "$tmp/pinch_replayed.vdb"
 
 # --- two strokes, undo both, redo one: the grid after the first stroke, exactly --------
 run --replay-input "$here/drag_ab_undo.json" --save "$tmp/undo.vdb" --save-script "$tmp/undo.json"
