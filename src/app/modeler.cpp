@@ -433,17 +433,11 @@ class Modeler {
         const bool sculpting = ctl_.drag() == DragKind::Sculpt;
         ImGui::BeginDisabled(sculpting);
         int m = int(s.mode);
-        ImGui::RadioButton("Grab (G)", &m, 0);
-        ImGui::SameLine();
-        ImGui::RadioButton("Twist (T)", &m, 1);
-        ImGui::SameLine();
-        ImGui::RadioButton("Inflate (I)", &m, 2);
-        ImGui::RadioButton("Swirl, keeps volume (S)", &m, 3);
-        ImGui::SameLine();
-        ImGui::RadioButton("Add clay (C)", &m, 4);
-        ImGui::RadioButton("Pinch a hole (P)", &m, 5);
-        ImGui::SameLine();
-        ImGui::RadioButton("Strangle (K)", &m, 6);
+        for (std::size_t k = 0; k < kModes.size(); ++k) {
+            // Three rows: the sweeps; swirl and clay; the topology tools.
+            if (k != 0 && k != 3 && k != 5) ImGui::SameLine();
+            ImGui::RadioButton(kModes[k].label, &m, int(kModes[k].mode));
+        }
         s.mode = SculptMode(m);
         ImGui::EndDisabled();
         if (s.mode == SculptMode::Pinch)

@@ -255,29 +255,13 @@ KeyAction SculptController::onKey(int key, bool ctrl, bool shift) {
     }
     if (ctrl && key == 'S') return KeyAction::Save;
     if (ctrl || (drag_ == DragKind::Sculpt && std::isalpha(key))) return KeyAction::None;
+    for (const ModeInfo& m : kModes)
+        if (key == m.key) {
+            settings_.mode = m.mode;
+            return KeyAction::None;
+        }
     double& size = shift ? settings_.falloff : settings_.radius; // [ and ]: shift for falloff
     switch (key) {
-    case 'G':
-        settings_.mode = SculptMode::Grab;
-        break;
-    case 'T':
-        settings_.mode = SculptMode::Twist;
-        break;
-    case 'S':
-        settings_.mode = SculptMode::Swirl;
-        break;
-    case 'C':
-        settings_.mode = SculptMode::Clay;
-        break;
-    case 'I':
-        settings_.mode = SculptMode::Inflate;
-        break;
-    case 'P':
-        settings_.mode = SculptMode::Pinch;
-        break;
-    case 'K':
-        settings_.mode = SculptMode::Strangle;
-        break;
     case 'F':
         if (!busy()) frameView();
         break;

@@ -6,6 +6,7 @@
 // replay files and read the recorded script, with no window at all.
 #pragma once
 
+#include <array>
 #include <chrono>
 #include <functional>
 #include <future>
@@ -29,6 +30,23 @@ namespace sweepers {
 // inflation, 2.30) under the cursor. Pinch and strangle change the topology (3.5): a drag
 // sets them up, shown as a preview, and the release applies the whole stroke.
 enum class SculptMode { Grab, Twist, Inflate, Swirl, Clay, Pinch, Strangle };
+
+// Each mode's key and its name in the panel, in SculptMode's order: the key handler and the
+// panel both read this table.
+struct ModeInfo {
+    SculptMode mode;
+    int key;
+    const char* label;
+};
+inline constexpr std::array<ModeInfo, 7> kModes{{
+    {SculptMode::Grab, 'G', "Grab (G)"},
+    {SculptMode::Twist, 'T', "Twist (T)"},
+    {SculptMode::Inflate, 'I', "Inflate (I)"},
+    {SculptMode::Swirl, 'S', "Swirl, keeps volume (S)"},
+    {SculptMode::Clay, 'C', "Add clay (C)"},
+    {SculptMode::Pinch, 'P', "Pinch a hole (P)"},
+    {SculptMode::Strangle, 'K', "Strangle (K)"},
+}};
 enum class DragKind { None, Sculpt, Orbit, Pan };
 
 struct ToolSettings {
