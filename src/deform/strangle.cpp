@@ -12,6 +12,7 @@ namespace sweepers {
 namespace {
 
 constexpr int kForwardIterations = 60; // as for the needles: a non-converged point is on the circle
+constexpr double kNooseSegmentRatio = 2.0;
 
 bool finitePositive(double v) {
     return v > 0.0 && std::isfinite(v);
@@ -134,12 +135,20 @@ std::vector<std::unique_ptr<StepDeformation>> planStrangle(const StrangleSpec& s
         if (radii.size() > 4'000'000)
             throw std::invalid_argument("the strangle would need millions of sub-steps");
     }
-    // Segments of at most a quarter of the falloff of contraction each, the last ones short.
+    // Segments of at most a quarter of the falloff of contraction each, and of at most a
+    // halving of the radius. A segment's inverse map stretches the wedge's faces by more
+    // than its ratio q (the field's angular slope adds about 7 ln q times r / d at distance
+    // d from the circle), and the advection widens the source band only up to a stretch of
+    // 32: past it the sampled values are clamped and the face comes out terraced to the
+    // grid. One last segment from a tenth of the size down to a quarter voxel went past it
+    // (at 1/128, 91% of the interface had a unit gradient); with halvings the largest
+    // stretch on the same strangle was about 27 (the band widened to 42 voxels).
     std::vector<std::unique_ptr<StepDeformation>> parts;
     std::size_t first = 0;
     for (std::size_t k = 1; k < radii.size(); ++k) {
         const bool last = k + 1 == radii.size();
-        if (last || radii[first] - radii[k + 1] > spec.falloff / 4.0) {
+        if (last || radii[first] - radii[k + 1] > spec.falloff / 4.0 ||
+            radii[first] > kNooseSegmentRatio * radii[k + 1]) {
             parts.push_back(std::make_unique<StrangleNoose>(
                 spec, std::vector<double>(radii.begin() + std::ptrdiff_t(first),
                                           radii.begin() + std::ptrdiff_t(k) + 1)));
