@@ -140,7 +140,7 @@ print("plots: convergence.png 1280x960 and a valid convergence.svg")
 PY
 
 # --- resuming after a SIGKILL ------------------------------------------------------------
-"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/128 \
+"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/64 \
   -q &
 pid=$!
 for _ in $(seq 1 400); do
@@ -153,7 +153,7 @@ done_rows=$(($(wc -l <"$tmp/killed/study.csv") - 1))
 [ "$done_rows" -ge 2 ] || fail "the study wrote $done_rows rows before it was killed"
 stamp() { stat -c %y "$tmp/killed/trilinear_16.vdb" "$tmp/killed/trilinear_32.vdb"; }
 before=$(stamp)
-"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/128 \
+"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/64 \
   -q 2>"$tmp/err"
 grep -q "3 runs ($done_rows reused from before, 0 failed)" "$tmp/err" ||
   fail "resume: $(cat "$tmp/err"), expected $done_rows reused"
