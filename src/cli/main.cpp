@@ -17,6 +17,7 @@
 #include <unistd.h>
 
 #include "io/atomic_file.h"
+#include "io/film_files.h"
 #include "io/mesh_file.h"
 #include "io/session_journal.h"
 #include "io/start_grid.h"
@@ -26,6 +27,7 @@
 #include "levelset/create.h"
 #include "levelset/measure.h"
 #include "mesh/marching_cubes.h"
+#include "sculpt/film.h"
 #include "sculpt/sculptor.h"
 
 namespace {
@@ -447,6 +449,133 @@ int runStudy(const StudyArgs& a) {
     return failed == 0 ? 0 : 1;
 }
 
+struct AnimateArgs {
+    std::string script, output, mesh, frames, fog, up = "y";
+    double fps = 24.0, secondsPerSegment = 0.25, voxelSize = 0.0;
+    bool quiet = false, force = false;
+};
+
+// "A-B" or "A", within 1..count.
+std::pair<std::size_t, std::size_t> parseFrameRange(const std::string& text, std::size_t count) {
+    if (text.empty()) return {1, count};
+    const std::string all = "1-" + std::to_string(count);
+    std::size_t a = 0, b = 0;
+    try {
+        std::size_t used = 0;
+        a = std::stoul(text, &used);
+        b = a;
+        if (used < text.size()) {
+            if (text[used] != '-') throw std::invalid_argument("");
+            std::size_t more = 0;
+            b = std::stoul(text.substr(used + 1), &more);
+            if (used + 1 + more != text.size()) throw std::invalid_argument("");
+        }
+    } catch (const std::exception&) {
+        throw std::runtime_error("--frames: '" + text + "' is not a frame range such as " + all);
+    }
+    if (a < 1 || a > b || b > count)
+        throw std::runtime_error("--frames: " + text + " is not within the film's frames " + all);
+    return {a, b};
+}
+
+// Plays a script as a film (sculpt/film.h) and writes one VDB per frame, each atomically,
+// so an interrupted film resumes: frames already written for the same script, timing and
+// voxel size are kept.
+int runAnimate(const AnimateArgs& a) {
+    const StrokeScript script = readStrokeScript(a.script);
+    std::string text;
+    {
+        std::ifstream in(a.script, std::ios::binary);
+        std::ostringstream ss;
+        ss << in.rdbuf();
+        text = ss.str();
+    }
+    if (a.voxelSize != 0.0 && !(a.voxelSize > 0.0 && std::isfinite(a.voxelSize)))
+        throw std::runtime_error("--voxel-size must be a positive number");
+    FilmTiming timing;
+    timing.fps = a.fps;
+    timing.secondsPerSegment = a.secondsPerSegment;
+    double seconds = 0.0;
+    for (const double d : strokeDurations(script, timing))
+        seconds += d;
+    const std::size_t count = filmFrameCount(seconds, timing.fps);
+    // (Plain variables: lambdas below capture them, which C++17 forbids for bindings.)
+    const std::pair<std::size_t, std::size_t> range = parseFrameRange(a.frames, count);
+    const std::size_t first = range.first, last = range.second;
+    // The frames' directories are made as a study's is.
+    auto frameDirectory = [&](const std::string& pattern) {
+        checkFramePattern(pattern);
+        const std::string path = framePath(pattern, first);
+        std::error_code ec;
+        std::filesystem::create_directories(directoryOf(path), ec);
+        if (ec)
+            throw std::runtime_error(path + ": cannot create its directory (" + ec.message() + ")");
+        requireWritable(path);
+    };
+    frameDirectory(a.output);
+    if (!a.mesh.empty()) {
+        requireMeshPath(framePath(a.mesh, first));
+        frameDirectory(a.mesh);
+    }
+
+    AdvectOptions options;
+    options.interrupter = &gStop;
+    Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop, a.force),
+                      options);
+    const double h = sculptor.grid().voxelSize()[0];
+    const std::string digest = scriptDigest(text);
+    auto stampOf = [&](std::size_t n) {
+        return FrameStamp{int(n), filmFrameTime(n, seconds, timing.fps), timing.fps, digest};
+    };
+    // Frames on disk from an earlier run of the same film are kept; anything else in their
+    // place is refused, unless --force, before any work starts.
+    std::vector<char> kept(last + 1, 0);
+    std::size_t keptCount = 0;
+    for (std::size_t n = first; n <= last && !a.force; ++n) {
+        const std::string path = framePath(a.output, n);
+        if (!std::filesystem::exists(path)) continue;
+        const std::optional<FrameStamp> on = readFrameStamp(path);
+        const FrameStamp want = stampOf(n);
+        if (!on || on->frame != want.frame || on->time != want.time || on->fps != want.fps ||
+            on->script != want.script || readLevelSet(path)->voxelSize()[0] != h)
+            throw std::runtime_error(path + ": not frame " + std::to_string(n) +
+                                     " of this film (another script, timing or voxel size); "
+                                     "--force overwrites it");
+        kept[n] = a.mesh.empty() || std::filesystem::exists(framePath(a.mesh, n));
+        keptCount += kept[n];
+    }
+    try {
+        playFilm(
+            sculptor, script, timing, first, last,
+            [&](std::size_t n, double, const Grid& grid) {
+                AtomicWrite vdb = prepareFrame(grid, stampOf(n), a.fog, framePath(a.output, n));
+                std::optional<AtomicWrite> meshFile;
+                if (!a.mesh.empty())
+                    meshFile.emplace(prepareMesh(exportedMesh(grid, a.up), framePath(a.mesh, n)));
+                vdb.commit();
+                if (meshFile) meshFile->commit();
+            },
+            [&](std::size_t n) { return !kept[n]; },
+            [&](std::size_t done, std::size_t all) {
+                if (!a.quiet)
+                    std::fprintf(stderr, "\ranimating %s: frame %zu / %zu", a.script.c_str(),
+                                 first + done - 1, last);
+                (void)all;
+            });
+    } catch (const Cancelled&) {
+        if (!a.quiet) std::fprintf(stderr, "\n");
+        std::fprintf(stderr,
+                     "sweepers-cli: interrupted; the frames written are kept (the same command "
+                     "resumes the film)\n");
+        return 130;
+    }
+    if (!a.quiet)
+        std::fprintf(stderr, "\nwrote frames %zu-%zu of %zu (%.4g s at %.4g fps) to %s%s\n", first,
+                     last, count, seconds, timing.fps, a.output.c_str(),
+                     keptCount ? (", " + std::to_string(keptCount) + " kept from before").c_str()
+                               : "");
+    return 0;
+}
 } // namespace
 
 static int run(int argc, char** argv) {
@@ -543,6 +672,39 @@ static int run(int argc, char** argv) {
                     "Build start shapes even when they seem to need more memory than is free");
     study->add_option("--threads", threads, "Worker threads")->check(CLI::Range(1, 1024));
 
+    AnimateArgs animateArgs;
+    CLI::App* animate = app.add_subcommand(
+        "animate", "Play a stroke script as a film: one level set per frame (a VDB sequence)");
+    animate->add_option("script", animateArgs.script, "Stroke script (JSON)")->required();
+    animate
+        ->add_option("-o,--output", animateArgs.output,
+                     "Frame files, the frame number in place of the '#' run "
+                     "(for example frames/shape_####.vdb)")
+        ->required();
+    animate->add_option("--fps", animateArgs.fps, "Frames per second (default 24)")
+        ->check(CLI::PositiveNumber);
+    animate
+        ->add_option("--seconds-per-segment", animateArgs.secondsPerSegment,
+                     "Duration of a path segment of a stroke without a duration "
+                     "(default 0.25)")
+        ->check(CLI::PositiveNumber);
+    animate->add_option("--frames", animateArgs.frames, "Only these frames: A-B or A");
+    animate->add_option("--mesh", animateArgs.mesh,
+                        "Also a mesh per frame (.ply, .obj or .stl, with a '#' run)");
+    animate->add_option("--up", animateArgs.up, "Up axis of the meshes (y or z, default y)")
+        ->check(CLI::IsMember({"y", "z"}));
+    animate
+        ->add_option("--fog", animateArgs.fog,
+                     "Also a fog volume of this name beside the level set (default: density)")
+        ->expected(0, 1)
+        ->default_str("density");
+    animate->add_option("--voxel-size", animateArgs.voxelSize, "Override the script's voxel size");
+    animate->add_flag("-q,--quiet", animateArgs.quiet, "No progress output");
+    animate->add_flag("--force", animateArgs.force,
+                      "Overwrite frames of another film; build the start even when it seems to "
+                      "need more memory than is free");
+    animate->add_option("--threads", threads, "Worker threads")->check(CLI::Range(1, 1024));
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -560,6 +722,7 @@ static int run(int argc, char** argv) {
         if (*apply) return runApply(applyArgs);
         if (*recover) return runRecover(path, output, scriptOut);
         if (*study) return runStudy(studyArgs);
+        if (*animate) return runAnimate(animateArgs);
         if (*create) {
             requireSphereSize(radius, voxelSize);
             requireWritable(output);

@@ -2,6 +2,8 @@
 // and scale (uniform or per local axis). As a world-from-local matrix it is T(t) R S.
 #pragma once
 
+#include <optional>
+
 #include <Eigen/Geometry>
 
 namespace sweepers {
@@ -19,5 +21,10 @@ struct Placement {
         return t == o.t && axis == o.axis && angleDegrees == o.angleDegrees && scale == o.scale;
     }
 };
+
+// The placement a fraction f of the way along the motion from a to b, exp(f log(B A^-1)) A
+// (as the sub-step placements of 3.12 are), or nullopt where that is not of the form T R S:
+// a scale along axes other than the tool's own, or a motion without a logarithm.
+std::optional<Placement> placementAlong(const Placement& a, const Placement& b, double f);
 
 } // namespace sweepers

@@ -478,8 +478,14 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
     if (!strokes.is_array()) r.fail("/strokes", "expected an array of strokes");
     for (std::size_t i = 0; i < strokes.size(); ++i) {
         const std::string at = "/strokes/" + std::to_string(i);
-        const json& v = strokes[i];
+        json v = strokes[i];
         if (!v.is_object()) r.fail(at, "expected an object");
+        // Any stroke may say how long it lasts in a film.
+        if (auto d = v.find("duration"); d != v.end()) {
+            s.durations.resize(i + 1, 0.0);
+            s.durations[i] = r.positive(*d, at + "/duration");
+            v.erase(d);
+        }
         const std::string type = r.string(r.require(v, at, "type"), at + "/type");
         if (type == "sweep")
             s.strokes.emplace_back(readSweep(r, v, at));
@@ -572,6 +578,8 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
         } else {
             j = topologyToolJson("strangle", std::get<StrangleStroke>(stroke));
         }
+        const std::size_t i = strokes.size();
+        if (i < s.durations.size() && s.durations[i] > 0.0) j["duration"] = s.durations[i];
         strokes.push_back(j);
     }
     root["strokes"] = strokes;

@@ -9,6 +9,7 @@
 //                  { "type": "swirl", "at": [..], "move": [..], "radius": r,
 //                    "ring": "discrete" | "convolution", "swirls": 8, "ball": rho },
 //                  { "type": "inflate", "at": [..], "radius": rho } ] }
+//     (any stroke may add "duration": seconds, for films: sculpt/film.h)
 //
 // Reading validates everything, including that every segment's motion has a logarithm,
 // and refuses the whole script on the first problem with a ScriptError whose message

@@ -115,13 +115,17 @@ class FileWriter : public openvdb::io::Archive {
 
 } // namespace
 
-AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path) {
+AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path, const openvdb::MetaMap& meta,
+                            const openvdb::GridCPtrVec& beside) {
     initVdb();
     GridPtr copy = grid.deepCopy();
     markAsDocument(*copy);
     copy->insertMeta("voxel_size", openvdb::FloatMetadata(float(grid.voxelSize()[0])));
-    return AtomicWrite(
-        path, [&](std::ostream& out) { FileWriter().writeTo(out, openvdb::GridCPtrVec{copy}); });
+    for (auto it = meta.beginMeta(); it != meta.endMeta(); ++it)
+        copy->insertMeta(it->first, *it->second);
+    openvdb::GridCPtrVec grids{copy};
+    grids.insert(grids.end(), beside.begin(), beside.end());
+    return AtomicWrite(path, [&](std::ostream& out) { FileWriter().writeTo(out, grids); });
 }
 
 void writeLevelSet(const Grid& grid, const std::string& path) {

@@ -37,7 +37,10 @@ GridPtr readLevelSet(const std::string& path, const std::string& gridName = "");
 LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& gridName = "");
 // Atomic (io/atomic_file.h): a failed write, a full disk included, keeps the old file.
 void writeLevelSet(const Grid& grid, const std::string& path);
-// The same, written and flushed but not yet in place: commit() puts it there.
-AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path);
+// The same, written and flushed but not yet in place: commit() puts it there. `meta` joins
+// the level set's metadata, and the grids `beside` follow it in the file.
+AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path,
+                            const openvdb::MetaMap& meta = {},
+                            const openvdb::GridCPtrVec& beside = {});
 
 } // namespace sweepers

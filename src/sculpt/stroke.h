@@ -98,6 +98,9 @@ struct StrokeScript {
     GridSpec grid;
     StartShape start;
     std::vector<Stroke> strokes;
+    // The seconds each stroke lasts when the script is played as a film (sculpt/film.h), by
+    // stroke; 0 or missing where the script does not say.
+    std::vector<double> durations;
 };
 
 // The deformation a sweep stroke describes. Throws std::invalid_argument for a baked tool

@@ -1,0 +1,122 @@
+#!/usr/bin/env bash
+# sweepers-cli animate: a script played as a film, one VDB per frame (and a mesh and a fog
+# volume when asked), read back by vdb_print and python3-openvdb; the ends of the film
+# against the start and `apply`; resuming; Ctrl-C; and every refusal with its message.
+. "$(dirname "$0")/common.sh" "$@"
+here=$(cd "$(dirname "$0")" && pwd)
+h=0.03125 # coarser than the script's 1/64: the same film, four times faster
+film="$data/animation/horn_film.json"
+
+# --- the horn as a 2-second film at 6 fps: 13 frames ---------------------------------------
+"$cli" animate "$film" -o "$tmp/f/horn_####.vdb" --fps 6 --voxel-size $h --fog \
+  --mesh "$tmp/m/horn_##.ply" -q
+[ "$(ls "$tmp/f" | wc -l)" = 13 ] || fail "expected 13 frames: $(ls "$tmp/f")"
+[ "$(ls "$tmp/m" | wc -l)" = 13 ] || fail "expected 13 meshes: $(ls "$tmp/m")"
+[ -f "$tmp/f/horn_0013.vdb" ] && [ -f "$tmp/m/horn_13.ply" ] || fail "numbering: $(ls "$tmp/f" "$tmp/m")"
+
+# Frame 1 is the start, the last frame what apply gives, voxel for voxel.
+"$cli" new -o "$tmp/start.vdb" --voxel-size $h --radius 1
+"$py" "$here/../app/same_grid.py" "$tmp/f/horn_0001.vdb" "$tmp/start.vdb"
+"$cli" apply "$film" -o "$tmp/applied.vdb" --voxel-size $h -q
+"$py" "$here/../app/same_grid.py" "$tmp/f/horn_0013.vdb" "$tmp/applied.vdb"
+
+# An independent reader sees both grids with their classes and the frame's metadata.
+vdb_print -l "$tmp/f/horn_0007.vdb" >"$tmp/print"
+grep -q "^Name: surface" "$tmp/print" && grep -q "^Name: density" "$tmp/print" &&
+  grep -q "class: level set" "$tmp/print" && grep -q "class: fog volume" "$tmp/print" &&
+  grep -q "frame: 7" "$tmp/print" || fail "vdb_print: $(cat "$tmp/print")"
+
+# Every frame: names, classes, metadata (time = (frame - 1) / fps, one script digest), the
+# volume growing with the horn, and a fog volume: 0 outside, 1 deep inside, in between
+# only across the inside of the band.
+"$py" - "$tmp/f" <<'PY'
+import glob, sys
+import numpy as np
+import pyopenvdb as vdb
+files = sorted(glob.glob(f"{sys.argv[1]}/horn_*.vdb"))
+digests, volumes = set(), []
+for n, path in enumerate(files, start=1):
+    grids, meta = vdb.readAll(path)
+    by_name = {g.name: g for g in grids}
+    assert set(by_name) == {"surface", "density"}, (path, by_name)
+    s, d = by_name["surface"], by_name["density"]
+    assert s.gridClass == vdb.GridClass.LEVEL_SET and d.gridClass == vdb.GridClass.FOG_VOLUME
+    for g in (s, d):
+        assert g["frame"] == n and abs(g["time"] - (n - 1) / 6) < 1e-12 and g["fps"] == 6, g.metadata
+    digests.add(s["script"])
+    h = s.transform.voxelSize()[0]
+    assert abs(h - 1 / 32) < 1e-12, h
+    lo, hi = s.evalActiveVoxelBoundingBox()
+    a = np.empty([hi[k] - lo[k] + 1 for k in range(3)], dtype=np.float32)
+    s.copyToArray(a, ijk=lo)
+    volumes.append(int((a < 0).sum()))
+    if n == 7:
+        acc, fog = s.getConstAccessor(), d.getConstAccessor()
+        assert fog.getValue((0, 0, 0)) == 1.0 and d.background == 0.0
+        assert fog.getValue((0, 200, 0)) == 0.0 and fog.getValue((60, 0, 0)) == 0.0
+        band = s.background
+        for ijk in [(i, 0, 0) for i in range(20, 40)]:
+            phi, rho = acc.getValue(ijk), fog.getValue(ijk)
+            expected = 0.0 if phi >= 0 else min(1.0, -phi / band)
+            assert abs(rho - expected) < 1e-5, (ijk, phi, rho)
+assert len(digests) == 1, digests
+# The voxels inside: the horn is pulled out frame after frame, none a still.
+assert all(b > a for a, b in zip(volumes, volumes[1:])), volumes
+print(f"{len(files)} frames read back: level set and fog volume, frame, time, fps, script")
+PY
+
+# The fog volume beside it changes nothing in the level set.
+"$cli" animate "$film" -o "$tmp/plain/horn_####.vdb" --fps 6 --voxel-size $h --frames 7 -q
+[ "$(ls "$tmp/plain")" = horn_0007.vdb ] || fail "--frames 7 wrote $(ls "$tmp/plain")"
+"$py" "$here/../app/same_grid.py" "$tmp/plain/horn_0007.vdb" "$tmp/f/horn_0007.vdb"
+
+# --- resuming: the frames of the same film are kept, a missing one is made again -----------
+stamps() { stat -c '%n %Y.%y' "$tmp/f"/*.vdb | grep -v horn_0004; }
+before=$(stamps)
+mv "$tmp/f/horn_0004.vdb" "$tmp/frame4.vdb"
+"$cli" animate "$film" -o "$tmp/f/horn_####.vdb" --fps 6 --voxel-size $h --fog \
+  --mesh "$tmp/m/horn_##.ply" 2>"$tmp/err"
+grep -q "wrote frames 1-13 of 13 (2 s at 6 fps) to $tmp/f/horn_####.vdb, 12 kept from before" \
+  "$tmp/err" || fail "resume: $(cat "$tmp/err")"
+[ "$(stamps)" = "$before" ] || fail "a kept frame was written again"
+"$py" "$here/../app/same_grid.py" "$tmp/f/horn_0004.vdb" "$tmp/frame4.vdb"
+echo "resumed: 12 frames kept, frame 4 made again"
+
+# --- Ctrl-C: the frames written are whole and kept ---------------------------------------
+"$cli" animate "$film" -o "$tmp/c/horn_####.vdb" --fps 6 --voxel-size $h -q 2>"$tmp/err" &
+pid=$!
+for _ in $(seq 1 400); do
+  [ "$(ls "$tmp/c" 2>/dev/null | grep -c 'vdb$')" -ge 3 ] && break
+  sleep 0.025
+done
+kill -INT "$pid"
+rc=0
+wait "$pid" || rc=$?
+[ "$rc" = 130 ] || fail "animate stopped by SIGINT exited $rc"
+grep -qx "sweepers-cli: interrupted; the frames written are kept (the same command resumes the film)" \
+  "$tmp/err" || fail "SIGINT: $(cat "$tmp/err")"
+if ls "$tmp/c" | grep -q "tmp-"; then fail "temporary files left: $(ls "$tmp/c")"; fi
+for f in "$tmp/c"/*.vdb; do "$cli" info "$f" >/dev/null || fail "$f is not whole"; done
+echo "stopped by SIGINT: exit 130, $(ls "$tmp/c" | wc -l) whole frames kept"
+
+# --- refusals: one line, nothing written -------------------------------------------------
+refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing or voxel size); --force overwrites it" \
+  animate "$data/horn.json" -o "$tmp/f/horn_####.vdb" --fps 6 --voxel-size $h
+refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing or voxel size); --force overwrites it" \
+  animate "$film" -o "$tmp/f/horn_####.vdb" --fps 24 --voxel-size $h
+refuses "sweepers-cli: $tmp/bad/horn.vdb: a frame pattern needs a run of '#' for the frame number (for example frames/shape_####.vdb)" \
+  animate "$film" -o "$tmp/bad/horn.vdb"
+refuses "sweepers-cli: $tmp/bad/h_##_##.vdb: a frame pattern holds one run of '#', not two" \
+  animate "$film" -o "$tmp/bad/h_##_##.vdb"
+refuses "sweepers-cli: --frames: 20-30 is not within the film's frames 1-13" \
+  animate "$film" -o "$tmp/bad/h_#.vdb" --fps 6 --frames 20-30
+refuses "sweepers-cli: --frames: 'ten' is not a frame range such as 1-13" \
+  animate "$film" -o "$tmp/bad/h_#.vdb" --fps 6 --frames ten
+touch "$tmp/file"
+refuses "sweepers-cli: $tmp/file/h_01.vdb: cannot create its directory (Not a directory)" \
+  animate "$film" -o "$tmp/file/h_##.vdb"
+sed 's/"duration": 1.2/"duration": -1/' "$film" >"$tmp/negative.json"
+refuses "sweepers-cli: $tmp/negative.json: /strokes/0/duration: must be positive (got -1)" \
+  animate "$tmp/negative.json" -o "$tmp/bad/h_#.vdb"
+[ ! -e "$tmp/bad" ] || fail "a refused film left $(ls -R "$tmp/bad")"
+echo "animate: all checks passed"
