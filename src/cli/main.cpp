@@ -82,6 +82,15 @@ int runCheck(const std::string& path, bool asJson) {
                 SwirlSegment(toSwirl(*swirl)), 0.0);
         } else if (std::holds_alternative<InflateStroke>(stroke)) {
             out.push_back({{"stroke", i}, {"type", "inflate"}});
+        } else if (keyedDuration(stroke) > 0.0) {
+            // As `apply` takes it: at its last key.
+            const bool keyframed = std::holds_alternative<KeyframedStroke>(stroke);
+            const auto parts = planKeyedStroke(stroke, keyedDuration(stroke));
+            if (parts.empty()) out.push_back({{"stroke", i}, {"type", "keyframed at rest"}});
+            for (std::size_t k = 0; k < parts.size(); ++k) {
+                const auto& seg = dynamic_cast<const SweepSegment&>(*parts[k]);
+                row(i, keyframed ? "keyframed" : "slide", k, seg.toolCount(), seg, seg.stepBound());
+            }
         } else {
             // A pinch or a strangle: its sub-steps depend on the voxel size (the script's).
             const auto* pinch = std::get_if<PinchStroke>(&stroke);
@@ -106,6 +115,11 @@ int runCheck(const std::string& path, bool asJson) {
     for (const auto& row : out) {
         if (row["type"] == "inflate") {
             std::cout << "  stroke " << row["stroke"] << ": inflate (reaches the whole shape)\n";
+            continue;
+        }
+        if (row["type"] == "keyframed at rest") {
+            std::cout << "  stroke " << row["stroke"]
+                      << ": keyframed, back at rest at its last key (apply leaves the shape)\n";
             continue;
         }
         if (row["type"] != "sweep") {

@@ -17,18 +17,12 @@ Eigen::Affine3d Placement::matrix() const {
     return X;
 }
 
-std::optional<Placement> placementAlong(const Placement& a, const Placement& b, double f) {
-    const Eigen::Matrix4d A = a.matrix().matrix();
-    Eigen::Matrix4d X;
-    try {
-        X = (f * MotionLog::log(b.matrix().matrix() * A.inverse())).exp() * A;
-    } catch (const std::domain_error&) {
-        return std::nullopt;
-    }
+std::optional<Placement> placementOf(const Eigen::Matrix4d& X) {
     // X = T R S: the polar decomposition of the linear part, R P, must have P diagonal.
     const Eigen::Matrix3d L = X.topLeftCorner<3, 3>();
     const Eigen::JacobiSVD<Eigen::Matrix3d> svd(L, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d U = svd.matrixU(), V = svd.matrixV();
+    Eigen::Matrix3d U = svd.matrixU();
+    const Eigen::Matrix3d& V = svd.matrixV();
     if ((U * V.transpose()).determinant() < 0.0) U.col(2) *= -1.0;
     const Eigen::Matrix3d R = U * V.transpose();
     const Eigen::Matrix3d P = R.transpose() * L;
@@ -45,6 +39,17 @@ std::optional<Placement> placementAlong(const Placement& a, const Placement& b, 
         p.angleDegrees = turn.angle() * 180.0 / M_PI;
     }
     return p;
+}
+
+std::optional<Placement> placementAlong(const Placement& a, const Placement& b, double f) {
+    const Eigen::Matrix4d A = a.matrix().matrix();
+    Eigen::Matrix4d X;
+    try {
+        X = (f * MotionLog::log(b.matrix().matrix() * A.inverse())).exp() * A;
+    } catch (const std::domain_error&) {
+        return std::nullopt;
+    }
+    return placementOf(X);
 }
 
 } // namespace sweepers

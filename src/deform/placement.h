@@ -22,6 +22,9 @@ struct Placement {
     }
 };
 
+// The placement whose matrix is X, when X is of the form T R S (nullopt otherwise).
+std::optional<Placement> placementOf(const Eigen::Matrix4d& X);
+
 // The placement a fraction f of the way along the motion from a to b, exp(f log(B A^-1)) A
 // (as the sub-step placements of 3.12 are), or nullopt where that is not of the form T R S:
 // a scale along axes other than the tool's own, or a motion without a logarithm.

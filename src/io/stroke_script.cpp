@@ -159,8 +159,13 @@ void loadTool(const Reader& r, ToolSpec& t, const std::string& at) {
     }
 }
 
-ToolSpec readTool(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"shape", "size", "falloff", "path"});
+// A tool with its path, or (`keyed`) with the placements keyed elsewhere as its path.
+ToolSpec readTool(const Reader& r, const json& v, const std::string& at,
+                  const std::vector<Placement>* keyed = nullptr) {
+    if (keyed)
+        r.onlyKeys(v, at, {"shape", "size", "falloff"});
+    else
+        r.onlyKeys(v, at, {"shape", "size", "falloff", "path"});
     ToolSpec t;
     const json& shapeValue = r.require(v, at, "shape");
     const std::string shape =
@@ -184,11 +189,15 @@ ToolSpec readTool(const Reader& r, const json& v, const std::string& at) {
                                   "{\"mesh\": file})");
     }
     t.falloff = r.positive(r.require(v, at, "falloff"), at + "/falloff");
-    const json& path = r.require(v, at, "path");
-    if (!path.is_array()) r.fail(at + "/path", "expected an array of placements");
-    if (path.size() < 2) r.fail(at + "/path", "a path needs at least two placements");
-    for (std::size_t i = 0; i < path.size(); ++i)
-        t.path.push_back(readPlacement(r, path[i], at + "/path/" + std::to_string(i)));
+    if (keyed) {
+        t.path = *keyed;
+    } else {
+        const json& path = r.require(v, at, "path");
+        if (!path.is_array()) r.fail(at + "/path", "expected an array of placements");
+        if (path.size() < 2) r.fail(at + "/path", "a path needs at least two placements");
+        for (std::size_t i = 0; i < path.size(); ++i)
+            t.path.push_back(readPlacement(r, path[i], at + "/path/" + std::to_string(i)));
+    }
     if (t.shape == ToolShapeKind::Baked) loadTool(r, t, at);
     return t;
 }
@@ -227,6 +236,60 @@ SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
                    std::string("segment ") + std::to_string(k) + ": " + e.what());
         }
     }
+    return s;
+}
+
+// "keys": [{"time": 0, "t": .., "r": .., "s": ..}, ...], from time 0, in increasing time.
+Keyframes readKeys(const Reader& r, const json& v, const std::string& at, bool uniformScale) {
+    const json& keys = r.require(v, at, "keys");
+    if (!keys.is_array() || keys.size() < 2)
+        r.fail(at + "/keys", "expected an array of at least two keys");
+    Keyframes k;
+    for (std::size_t i = 0; i < keys.size(); ++i) {
+        const std::string key = at + "/keys/" + std::to_string(i);
+        if (!keys[i].is_object()) r.fail(key, "expected an object");
+        json placement = keys[i];
+        const double time = r.number(r.require(placement, key, "time"), key + "/time");
+        placement.erase("time");
+        if (i == 0 && time != 0.0) r.fail(key + "/time", "the first key is at time 0");
+        if (i > 0 && !(time > k.times.back()))
+            r.fail(key + "/time", "keys must come in increasing time (this one is at " +
+                                      keys[i]["time"].dump() + ", the one before at " +
+                                      keys[i - 1]["time"].dump() + ")");
+        k.times.push_back(time);
+        k.placements.push_back(readPlacement(r, placement, key));
+        if (uniformScale && !k.placements.back().uniformScale())
+            r.fail(key + "/s", "a slide's frame can only be scaled uniformly");
+    }
+    return k;
+}
+
+KeyframedStroke readKeyframed(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"type", "tool", "keys"});
+    KeyframedStroke s;
+    s.keys = readKeys(r, v, at, false);
+    s.tool = readTool(r, r.require(v, at, "tool"), at + "/tool", &s.keys.placements);
+    // Every keyed placement must be reachable from the rest by one motion with a logarithm.
+    for (std::size_t i = 1; i < s.keys.placements.size(); ++i) {
+        SweepStroke grab;
+        grab.tools = {s.tool};
+        grab.tools[0].path = {s.keys.placements[0], s.keys.placements[i]};
+        try {
+            SweepSegment segment(toSweep(grab), 0);
+        } catch (const std::exception& e) {
+            r.fail(at + "/keys/" + std::to_string(i), std::string("from the rest: ") + e.what());
+        }
+    }
+    return s;
+}
+
+SlideStroke readSlide(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"type", "mirror", "tools", "keys"});
+    SlideStroke s;
+    json local = v;
+    local.erase("keys");
+    s.local = readSweep(r, local, at);
+    s.frame = readKeys(r, v, at, true);
     return s;
 }
 
@@ -497,9 +560,16 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
             s.strokes.emplace_back(readTopologyTool<PinchStroke>(r, v, at, checkPinch));
         else if (type == "strangle")
             s.strokes.emplace_back(readTopologyTool<StrangleStroke>(r, v, at, checkStrangle));
+        else if (type == "keyframed")
+            s.strokes.emplace_back(readKeyframed(r, v, at));
+        else if (type == "slide")
+            s.strokes.emplace_back(readSlide(r, v, at));
         else
             r.fail(at + "/type", "unknown stroke type \"" + type +
-                                     "\" (expected sweep, swirl, inflate, pinch or strangle)");
+                                     "\" (expected sweep, swirl, inflate, pinch, strangle, "
+                                     "keyframed or slide)");
+        if (keyedDuration(s.strokes.back()) > 0.0 && i < s.durations.size() && s.durations[i] > 0.0)
+            r.fail(at + "/duration", "a " + type + " stroke lasts until its last key");
     }
     return s;
 }
@@ -512,6 +582,53 @@ StrokeScript readStrokeScript(const std::string& path) {
     if (in.bad()) throw ScriptError(path + ": cannot read the file");
     return parseStrokeScript(ss.str(), path, directoryOf(path));
 }
+
+namespace {
+
+json toolJson(const ToolSpec& t, bool withPath) {
+    json tj;
+    switch (t.shape) {
+    case ToolShapeKind::Ball:
+        tj["shape"] = "ball";
+        tj["size"] = t.size.x();
+        break;
+    case ToolShapeKind::Ellipsoid:
+        tj["shape"] = "ellipsoid";
+        tj["size"] = vecJson(t.size);
+        break;
+    case ToolShapeKind::Baked:
+        tj["shape"] = bakedSourceJson(t.source);
+        tj["size"] = t.size.x();
+        break;
+    }
+    tj["falloff"] = t.falloff;
+    if (withPath) {
+        json path = json::array();
+        for (const Placement& p : t.path)
+            path.push_back(placementJson(p));
+        tj["path"] = path;
+    }
+    return tj;
+}
+
+json toolsJson(const SweepStroke& sweep) {
+    json tools = json::array();
+    for (const ToolSpec& t : sweep.tools)
+        tools.push_back(toolJson(t, true));
+    return tools;
+}
+
+json keysJson(const Keyframes& keys) {
+    json out = json::array();
+    for (std::size_t i = 0; i < keys.times.size(); ++i) {
+        json k = placementJson(keys.placements[i]);
+        k["time"] = keys.times[i];
+        out.push_back(k);
+    }
+    return out;
+}
+
+} // namespace
 
 std::string formatStrokeScript(const StrokeScript& s, int indent) {
     json root;
@@ -536,31 +653,7 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
         if (const auto* sw = std::get_if<SweepStroke>(&stroke)) {
             j["type"] = "sweep";
             if (sw->mirror != MirrorAxis::None) j["mirror"] = mirrorName(sw->mirror);
-            json tools = json::array();
-            for (const ToolSpec& t : sw->tools) {
-                json tj;
-                switch (t.shape) {
-                case ToolShapeKind::Ball:
-                    tj["shape"] = "ball";
-                    tj["size"] = t.size.x();
-                    break;
-                case ToolShapeKind::Ellipsoid:
-                    tj["shape"] = "ellipsoid";
-                    tj["size"] = vecJson(t.size);
-                    break;
-                case ToolShapeKind::Baked:
-                    tj["shape"] = bakedSourceJson(t.source);
-                    tj["size"] = t.size.x();
-                    break;
-                }
-                tj["falloff"] = t.falloff;
-                json path = json::array();
-                for (const Placement& p : t.path)
-                    path.push_back(placementJson(p));
-                tj["path"] = path;
-                tools.push_back(tj);
-            }
-            j["tools"] = tools;
+            j["tools"] = toolsJson(*sw);
         } else if (const auto* sr = std::get_if<SwirlStroke>(&stroke)) {
             j["type"] = "swirl";
             j["at"] = vecJson(sr->at);
@@ -575,8 +668,19 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             j["radius"] = in->radius;
         } else if (const auto* pinch = std::get_if<PinchStroke>(&stroke)) {
             j = topologyToolJson("pinch", *pinch);
+        } else if (const auto* strangle = std::get_if<StrangleStroke>(&stroke)) {
+            j = topologyToolJson("strangle", *strangle);
+        } else if (const auto* keyed = std::get_if<KeyframedStroke>(&stroke)) {
+            j["type"] = "keyframed";
+            j["tool"] = toolJson(keyed->tool, false);
+            j["keys"] = keysJson(keyed->keys);
         } else {
-            j = topologyToolJson("strangle", std::get<StrangleStroke>(stroke));
+            const SlideStroke& slide = std::get<SlideStroke>(stroke);
+            j["type"] = "slide";
+            if (slide.local.mirror != MirrorAxis::None)
+                j["mirror"] = mirrorName(slide.local.mirror);
+            j["tools"] = toolsJson(slide.local);
+            j["keys"] = keysJson(slide.frame);
         }
         const std::size_t i = strokes.size();
         if (i < s.durations.size() && s.durations[i] > 0.0) j["duration"] = s.durations[i];
@@ -592,10 +696,18 @@ StrokeScript withAbsoluteFiles(StrokeScript s, const std::string& scriptDir) {
             file = std::filesystem::absolute(resolveAgainst(file, scriptDir)).string();
     };
     if (s.start.kind != StartShape::Kind::Sphere) absolute(s.start.file);
-    for (Stroke& stroke : s.strokes)
+    for (Stroke& stroke : s.strokes) {
+        std::vector<ToolSpec*> tools;
         if (auto* sweep = std::get_if<SweepStroke>(&stroke))
             for (ToolSpec& t : sweep->tools)
-                if (t.shape == ToolShapeKind::Baked) absolute(t.source.file);
+                tools.push_back(&t);
+        if (auto* slide = std::get_if<SlideStroke>(&stroke))
+            for (ToolSpec& t : slide->local.tools)
+                tools.push_back(&t);
+        if (auto* keyed = std::get_if<KeyframedStroke>(&stroke)) tools.push_back(&keyed->tool);
+        for (ToolSpec* t : tools)
+            if (t->shape == ToolShapeKind::Baked) absolute(t->source.file);
+    }
     return s;
 }
 

@@ -45,8 +45,11 @@ std::vector<double> strokeDurations(const StrokeScript& script, const FilmTiming
         throw std::invalid_argument("the seconds per segment must be positive");
     std::vector<double> seconds;
     for (std::size_t i = 0; i < script.strokes.size(); ++i) {
+        // A keyed stroke lasts until its last key.
+        const double keyed = keyedDuration(script.strokes[i]);
         const double given = i < script.durations.size() ? script.durations[i] : 0.0;
-        seconds.push_back(given > 0.0
+        seconds.push_back(keyed > 0.0 ? keyed
+                          : given > 0.0
                               ? given
                               : timing.secondsPerSegment * double(pathSegments(script.strokes[i])));
     }
@@ -80,7 +83,41 @@ void playFilm(Sculptor& sculptor, const StrokeScript& script, const FilmTiming& 
         ++frame;
     };
     double start = 0.0; // of the current deformation
+    // Shows `frame` with the deformations on top of the shape so far, then takes them back.
+    auto emitWith = [&](double time, const std::vector<const StepDeformation*>& on) {
+        if (on.empty()) return emit(time);
+        sculptor.startRecording();
+        for (const StepDeformation* d : on)
+            sculptor.applySegment(*d);
+        emit(time);
+        sculptor.restoreRecording();
+        sculptor.stopRecording();
+    };
     for (std::size_t i = 0; i < script.strokes.size() && frame <= last; ++i) {
+        if (keyedDuration(script.strokes[i]) > 0.0) {
+            // A keyed stroke: each frame from the shape the stroke starts from, by the stroke
+            // at that time (never from the frame before), then the stroke at its last key.
+            const double end = start + durations[i];
+            while (frame <= last) {
+                const double time = filmFrameTime(frame, total, timing.fps);
+                if (time >= end) break;
+                if (wanted && !wanted(frame)) {
+                    emit(time);
+                    continue;
+                }
+                const auto parts = planKeyedStroke(script.strokes[i], time - start);
+                std::vector<const StepDeformation*> on;
+                on.reserve(parts.size());
+                for (const auto& part : parts)
+                    on.push_back(part.get());
+                emitWith(time, on);
+            }
+            if (frame > last) break;
+            for (const auto& part : planStroke(sculptor.grid(), script.strokes[i]))
+                sculptor.applySegment(*part);
+            start = end;
+            continue;
+        }
         const auto parts = planStroke(sculptor.grid(), script.strokes[i]);
         const double each = durations[i] / double(parts.size());
         for (std::size_t k = 0; k < parts.size() && frame <= last; ++k) {
@@ -102,15 +139,10 @@ void playFilm(Sculptor& sculptor, const StrokeScript& script, const FilmTiming& 
                         if (done > 0) partial = std::make_unique<StepPrefix>(part, int(done));
                     }
                 }
-                if (!partial) {
+                if (partial)
+                    emitWith(time, {partial.get()});
+                else
                     emit(time);
-                    continue;
-                }
-                sculptor.startRecording();
-                sculptor.applySegment(*partial);
-                emit(time);
-                sculptor.restoreRecording();
-                sculptor.stopRecording();
             }
             sculptor.applySegment(part);
             start = end;

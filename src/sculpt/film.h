@@ -4,7 +4,9 @@
 // deformations (a sweep's segments, a pinch's or a strangle's parts) share that time
 // equally, and a frame that falls inside one shows the sub-steps done by then
 // (deform/step_prefix.h), applied on top of the shape so far and taken back after the frame.
-// The frames go through the one stroke path, so the last frame is what `apply` gives.
+// A keyed stroke (keyframed, slide) lasts until its last key, and each of its frames is the
+// shape it started from under the stroke at that time. The frames go through the one
+// stroke path, so the last frame is what `apply` gives.
 #pragma once
 
 #include <cstddef>

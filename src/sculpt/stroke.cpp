@@ -48,12 +48,49 @@ SwirlSpec toSwirl(const SwirlStroke& stroke) {
     return s;
 }
 
+double keyedDuration(const Stroke& stroke) {
+    if (const auto* k = std::get_if<KeyframedStroke>(&stroke)) return k->keys.times.back();
+    if (const auto* sl = std::get_if<SlideStroke>(&stroke)) return sl->frame.times.back();
+    return 0.0;
+}
+
+std::vector<std::unique_ptr<StepDeformation>> planKeyedStroke(const Stroke& stroke, double time) {
+    std::vector<std::unique_ptr<StepDeformation>> parts;
+    if (const auto* k = std::get_if<KeyframedStroke>(&stroke)) {
+        const Placement rest = k->keys.placements.front();
+        const Placement target = keyedPlacement(k->keys, time);
+        if (target == rest) return parts;
+        SweepStroke grab;
+        grab.tools = {k->tool};
+        grab.tools[0].path = {rest, target};
+        parts.push_back(std::make_unique<SweepSegment>(toSweep(grab), 0));
+        return parts;
+    }
+    const auto* slide = std::get_if<SlideStroke>(&stroke);
+    if (!slide) throw std::invalid_argument("not a keyed stroke");
+    const Eigen::Matrix4d F = keyedPlacement(slide->frame, time).matrix().matrix();
+    SweepStroke moved = slide->local;
+    for (ToolSpec& tool : moved.tools)
+        for (Placement& p : tool.path) {
+            // A uniform scale commutes with the rotations: F P is T R S again.
+            const std::optional<Placement> q = placementOf(F * p.matrix().matrix());
+            if (!q) throw std::invalid_argument("a slide's frame must scale uniformly");
+            p = *q;
+        }
+    const Sweep sweep = toSweep(moved);
+    for (std::size_t k = 0; k < sweep.segmentCount(); ++k)
+        parts.push_back(std::make_unique<SweepSegment>(sweep, k));
+    return parts;
+}
+
 std::size_t segmentCount(const Stroke& stroke, double voxelSize) {
     if (const auto* sweep = std::get_if<SweepStroke>(&stroke))
         return toSweep(*sweep).segmentCount();
     if (const auto* pinch = std::get_if<PinchStroke>(&stroke)) return pinchSegmentCount(*pinch);
     if (const auto* strangle = std::get_if<StrangleStroke>(&stroke))
         return planStrangle(*strangle, voxelSize).size();
+    if (const auto* slide = std::get_if<SlideStroke>(&stroke))
+        return toSweep(slide->local).segmentCount();
     return 1;
 }
 
@@ -63,25 +100,28 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
     // A swirl carrying a ball and an inflation reach the whole shape (found by walking the
     // grid: only for those two).
     auto reach = [&] { return activeWorldBox(grid).expanded(2 * grid.voxelSize()[0]); };
-    std::visit(Overloaded{
-                   [&](const SweepStroke& s) {
-                       const Sweep sweep = toSweep(s);
-                       for (std::size_t k = 0; k < sweep.segmentCount(); ++k)
-                           parts.push_back(std::make_unique<SweepSegment>(sweep, k));
-                   },
-                   [&](const SwirlStroke& s) {
-                       if (s.ball > 0.0)
-                           parts.push_back(starShapedSwirl(toSwirl(s), s.ball, reach()));
-                       else
-                           parts.push_back(std::make_unique<SwirlSegment>(toSwirl(s)));
-                   },
-                   [&](const InflateStroke& s) {
-                       parts.push_back(std::make_unique<Inflation>(s.at, s.radius, reach()));
-                   },
-                   [&](const PinchStroke& s) { parts = planPinch(s, grid.voxelSize()[0]); },
-                   [&](const StrangleStroke& s) { parts = planStrangle(s, grid.voxelSize()[0]); },
-               },
-               stroke);
+    std::visit(
+        Overloaded{
+            [&](const SweepStroke& s) {
+                const Sweep sweep = toSweep(s);
+                for (std::size_t k = 0; k < sweep.segmentCount(); ++k)
+                    parts.push_back(std::make_unique<SweepSegment>(sweep, k));
+            },
+            [&](const SwirlStroke& s) {
+                if (s.ball > 0.0)
+                    parts.push_back(starShapedSwirl(toSwirl(s), s.ball, reach()));
+                else
+                    parts.push_back(std::make_unique<SwirlSegment>(toSwirl(s)));
+            },
+            [&](const InflateStroke& s) {
+                parts.push_back(std::make_unique<Inflation>(s.at, s.radius, reach()));
+            },
+            [&](const PinchStroke& s) { parts = planPinch(s, grid.voxelSize()[0]); },
+            [&](const StrangleStroke& s) { parts = planStrangle(s, grid.voxelSize()[0]); },
+            [&](const KeyframedStroke&) { parts = planKeyedStroke(stroke, keyedDuration(stroke)); },
+            [&](const SlideStroke&) { parts = planKeyedStroke(stroke, keyedDuration(stroke)); },
+        },
+        stroke);
     return parts;
 }
 

@@ -9,6 +9,8 @@
 //   pinch   - two needles poke a hole through the shape, then pull it open (3.5.1)
 //   strangle - a circle contracts around a limb until it parts, then pulls the parts apart
 //             (3.5.2)
+//   keyframed - a tool whose target placement is keyed over time (3.6.1)
+//   slide   - a sweep in a local frame keyed over time (3.6.1)
 #pragma once
 
 #include <cstddef>
@@ -19,6 +21,7 @@
 
 #include <Eigen/Core>
 
+#include "deform/keyframes.h"
 #include "deform/pinch.h"
 #include "deform/placement.h"
 #include "deform/step_deformation.h"
@@ -91,7 +94,25 @@ struct InflateStroke {
 struct PinchStroke : PinchSpec {};
 struct StrangleStroke : StrangleSpec {};
 
-using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke, PinchStroke, StrangleStroke>;
+// A tool held in the modeling space whose target placement is keyed over time (3.6.1, the
+// first technique; Figure 3.23): at time t of the stroke, the shape it started from is
+// deformed by one sweep of the tool from its rest placement (the first key) to the keyed
+// placement at t. A grab that follows a curve, and lets go as the curve comes back.
+struct KeyframedStroke {
+    ToolSpec tool; // its path: the keys' placements
+    Keyframes keys;
+};
+
+// A sweep defined in a local frame, and the frame keyed over time (3.6.1, the second
+// technique; Figure 3.25): at time t of the stroke, the sweep with every placement taken
+// through the frame at t (a bulge moving along a pipe). Frames scale uniformly.
+struct SlideStroke {
+    SweepStroke local;
+    Keyframes frame;
+};
+
+using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke, PinchStroke, StrangleStroke,
+                            KeyframedStroke, SlideStroke>;
 
 struct StrokeScript {
     int version = 1;
@@ -109,13 +130,22 @@ Sweep toSweep(const SweepStroke& stroke);
 // The swirl ring a swirl stroke describes.
 SwirlSpec toSwirl(const SwirlStroke& stroke);
 
+// Whether the stroke is keyed over time (keyframed, slide), and then how long it lasts (its
+// last key's time); 0 for other strokes.
+double keyedDuration(const Stroke& stroke);
+
+// The deformations a keyed stroke makes at `time` of its own clock (empty where it is the
+// identity, as a keyframed tool at rest). Throws std::invalid_argument for another stroke.
+std::vector<std::unique_ptr<StepDeformation>> planKeyedStroke(const Stroke& stroke, double time);
+
 // How many deformations planStroke makes of a stroke at the given voxel size (a sweep's
 // segments, a pinch's or a strangle's segments and its pull, else one).
 std::size_t segmentCount(const Stroke& stroke, double voxelSize);
 
 // The deformations of one stroke, in order: a sweep's segments, one swirl ring or
 // inflation (whose reach depends on the grid as it is when the stroke comes), or the
-// segments of a pinch or a strangle (whose sub-steps depend on the voxel size).
+// segments of a pinch or a strangle (whose sub-steps depend on the voxel size), or those of
+// a keyed stroke at its last key.
 std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke);
 
 } // namespace sweepers

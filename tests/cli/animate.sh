@@ -70,6 +70,20 @@ PY
 [ "$(ls "$tmp/plain")" = horn_0007.vdb ] || fail "--frames 7 wrote $(ls "$tmp/plain")"
 "$py" "$here/../app/same_grid.py" "$tmp/plain/horn_0007.vdb" "$tmp/f/horn_0007.vdb"
 
+# --- keyed strokes: a grab that comes back gives back the start; a bulge slides -----------
+"$cli" animate "$data/animation/keyframed_grab.json" -o "$tmp/g/grab_#.vdb" --fps 4 \
+  --voxel-size $h -q
+[ "$(ls "$tmp/g" | wc -l)" = 9 ] || fail "the 2-second grab at 4 fps: $(ls "$tmp/g")"
+"$py" "$here/../app/same_grid.py" "$tmp/g/grab_1.vdb" "$tmp/start.vdb"
+"$py" "$here/../app/same_grid.py" "$tmp/g/grab_9.vdb" "$tmp/start.vdb"
+volume() { "$cli" info --json "$1" | "$py" -c 'import json, sys; print(json.load(sys.stdin)["volume"])'; }
+"$py" -c 'import sys; a, b = map(float, sys.argv[1:]); assert b > a + 0.1, (a, b)' \
+  "$(volume "$tmp/start.vdb")" "$(volume "$tmp/g/grab_5.vdb")" || fail "the grab pulled nothing"
+"$cli" animate "$data/animation/sliding_bulge.json" -o "$tmp/s/bulge_#.vdb" --fps 2 \
+  --voxel-size $h -q
+[ "$(ls "$tmp/s" | wc -l)" = 5 ] || fail "the 2-second slide at 2 fps: $(ls "$tmp/s")"
+echo "keyed strokes: the grab comes back to the start, the bulge slides in 5 frames"
+
 # --- resuming: the frames of the same film are kept, a missing one is made again -----------
 stamps() { stat -c '%n %Y.%y' "$tmp/f"/*.vdb | grep -v horn_0004; }
 before=$(stamps)

@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include <gtest/gtest.h>
+#include <openvdb/tools/Interpolation.h>
 
 #include "deform/step_prefix.h"
 #include "grids.h"
@@ -173,4 +174,181 @@ TEST(Film, DurationsRoundTripAndANegativeOneIsRefused) {
     } catch (const ScriptError& e) {
         EXPECT_STREQ(e.what(), "bad.json: /strokes/0/duration: must be positive (got -1)");
     }
+}
+
+namespace {
+
+// A grab: the ball at rest on the sphere's side, pulled out along a curve and back (3.6.1,
+// Figure 3.23), a second long.
+const char* kGrab = R"({
+  "sweepers": 1,
+  "grid": { "voxel_size": 0.03125, "half_width": 3 },
+  "start": { "sphere": { "center": [0, 0, 0], "radius": 0.5 } },
+  "strokes": [
+    { "type": "keyframed",
+      "tool": { "shape": "ball", "size": 0.2, "falloff": 0.3 },
+      "keys": [ { "time": 0, "t": [0.45, 0, 0] }, { "time": 0.4, "t": [0.65, 0.1, 0] },
+                { "time": 0.6, "t": [0.65, -0.1, 0] }, { "time": 1, "t": [0.45, 0, 0] } ] }
+  ]
+})";
+
+// A bump pushed out of the top of a big sphere (nearly flat there) in the frame, which
+// slides along x (3.6.1, Figure 3.25), a second long.
+const char* kSlide = R"({
+  "sweepers": 1,
+  "grid": { "voxel_size": 0.03125, "half_width": 3 },
+  "start": { "sphere": { "center": [0, -1.5, 0], "radius": 2 } },
+  "strokes": [
+    { "type": "slide",
+      "tools": [ { "shape": "ball", "size": 0.15, "falloff": 0.2,
+                   "path": [ { "t": [0, 0.45, 0] }, { "t": [0, 0.6, 0] } ] } ],
+      "keys": [ { "time": 0, "t": [-0.25, 0, 0] }, { "time": 1, "t": [0.25, 0, 0] } ] }
+  ]
+})";
+
+// Where the surface crosses the vertical line at x (z = 0), from above.
+double heightAt(const Grid& g, double x) {
+    const auto acc = g.getConstAccessor();
+    const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> s(
+        acc, g.transform());
+    const double h = g.voxelSize()[0];
+    for (double y = 1.0; y > 0.0; y -= h / 4)
+        if (s.wsSample(openvdb::Vec3d(x, y, 0.0)) <= 0.0) return y;
+    return 0.0;
+}
+
+// The x of the centre of the bump the surface has over `base` (at z = 0): the mean of x
+// weighted by the height the bump adds.
+double bumpAt(const Grid& g, const Grid& base) {
+    const double h = g.voxelSize()[0];
+    double sum = 0.0, moment = 0.0;
+    for (double x = -0.7; x <= 0.7; x += h / 2) {
+        const double rise = heightAt(g, x) - heightAt(base, x);
+        sum += rise;
+        moment += rise * x;
+    }
+    return moment / sum;
+}
+
+} // namespace
+
+TEST(Keyframes, ThroughEveryKeyAndHeldAtTheEnds) {
+    Keyframes k;
+    k.times = {0.0, 0.5, 2.0};
+    Placement a, b, c;
+    b.t = {1, 0, 0};
+    b.axis = {0, 0, 1};
+    b.angleDegrees = 40.0;
+    c.t = {1, 1, 0};
+    c.scale = Eigen::Vector3d::Constant(2.0);
+    k.placements = {a, b, c};
+    for (std::size_t i = 0; i < 3; ++i)
+        EXPECT_TRUE(
+            keyedPlacement(k, k.times[i]).matrix().isApprox(k.placements[i].matrix(), 1e-12));
+    EXPECT_TRUE(keyedPlacement(k, 5.0).matrix().isApprox(c.matrix(), 1e-12));
+    // Between keys: smooth, not a straight line (the middle key's tangent bends it).
+    const Placement mid = keyedPlacement(k, 1.25);
+    EXPECT_GT(mid.t.y(), 0.0);
+    EXPECT_LT(mid.t.y(), 1.0);
+    EXPECT_GT(mid.scale.x(), 1.0);
+    k.times = {0.0, 0.5, 0.5};
+    EXPECT_THROW(checkKeyframes(k), std::invalid_argument);
+}
+
+TEST(Film, AKeyframedGrabThatComesBackGivesBackTheStart) {
+    const StrokeScript s = parseStrokeScript(kGrab, "grab.json");
+    FilmTiming timing;
+    timing.fps = 10.0; // 11 frames
+    const auto frames = play(s, timing);
+    ASSERT_EQ(frames.size(), 11u);
+    Sculptor start = startOf(s);
+    const double rest = measureLevelSet(start.grid()).volume;
+    // Out along the curve, and back: the middle frames are pulled, the last is the start.
+    EXPECT_GT(measureLevelSet(*frames.at(5)).volume, rest + 1e-3);
+    // At 0.4 s the ball is up at (0.65, 0.1): the grabbed clay reaches x = 0.6 above the
+    // equator, which the sphere (radius 0.5) does not.
+    EXPECT_EQ(heightAt(start.grid(), 0.6), 0.0);
+    EXPECT_GT(heightAt(*frames.at(5), 0.6), 0.0);
+    EXPECT_EQ(test::differingVoxels(*frames.at(11), start.grid()), 0u);
+    // Every frame from the start shape: frame 7 alone is frame 7 of the whole film.
+    const auto alone = play(s, timing, 7, 7);
+    EXPECT_EQ(test::differingVoxels(*alone.at(7), *frames.at(7)), 0u);
+    // apply takes the stroke at its last key: the start again.
+    applyStrokes(start, s.strokes);
+    EXPECT_EQ(test::differingVoxels(*frames.at(11), start.grid()), 0u);
+}
+
+TEST(Film, ASlidingBumpFollowsItsFrame) {
+    const StrokeScript s = parseStrokeScript(kSlide, "slide.json");
+    FilmTiming timing;
+    timing.fps = 4.0; // frames at 0, 0.25, 0.5, 0.75, 1 s
+    const auto frames = play(s, timing);
+    ASSERT_EQ(frames.size(), 5u);
+    const double h = s.grid.voxelSize;
+    const Sculptor start = startOf(s);
+    for (std::size_t n = 1; n <= 5; ++n) {
+        const double frameX = -0.25 + 0.5 * double(n - 1) / 4.0;
+        EXPECT_NEAR(bumpAt(*frames.at(n), start.grid()), frameX, h) << "frame " << n;
+        EXPECT_GT(heightAt(*frames.at(n), frameX), 0.5 + 3 * h) << "frame " << n;
+    }
+    Sculptor applied = startOf(s);
+    applyStrokes(applied, s.strokes);
+    EXPECT_EQ(test::differingVoxels(*frames.at(5), applied.grid()), 0u);
+}
+
+TEST(Film, KeyedStrokesRoundTripAndBadKeysAreRefused) {
+    for (const char* text : {kGrab, kSlide}) {
+        const StrokeScript s = parseStrokeScript(text, "keyed.json");
+        const std::string once = formatStrokeScript(s);
+        EXPECT_EQ(formatStrokeScript(parseStrokeScript(once, "again.json")), once);
+    }
+    const auto refusal = [](std::string text, const std::string& from, const std::string& to) {
+        text.replace(text.find(from), from.size(), to);
+        try {
+            parseStrokeScript(text, "bad.json");
+        } catch (const ScriptError& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
+    EXPECT_EQ(refusal(kGrab, "\"time\": 0.6", "\"time\": 0.3"),
+              "bad.json: /strokes/0/keys/2/time: keys must come in increasing time (this one is "
+              "at 0.3, the one before at 0.4)");
+    EXPECT_EQ(refusal(kGrab, "\"time\": 0, \"t\"", "\"time\": 0.1, \"t\""),
+              "bad.json: /strokes/0/keys/0/time: the first key is at time 0");
+    EXPECT_EQ(
+        refusal(kGrab, "\"type\": \"keyframed\",", "\"type\": \"keyframed\", \"duration\": 2,"),
+        "bad.json: /strokes/0/duration: a keyframed stroke lasts until its last key");
+    EXPECT_EQ(refusal(kSlide, "\"time\": 1, \"t\": [0.25, 0, 0]",
+                      "\"time\": 1, \"t\": [0.25, 0, 0], \"s\": [1, 2, 1]"),
+              "bad.json: /strokes/0/keys/1/s: a slide's frame can only be scaled uniformly");
+}
+
+TEST(Film, AnEditedKeyChangesOnlyTheFramesItShapes) {
+    // Six keys a fifth of a second apart; key 1 moved: the spline changes between key 0 and
+    // key 3 (0 to 0.6 s) and passes through the other keys still, so at 10 fps frames 2, 3,
+    // 4 and 6 change (0.1, 0.2, 0.3 and 0.5 s) and the others do not (5 and 7 at keys 2 and 3).
+    std::string text = kGrab;
+    const std::string keys =
+        R"("keys": [ { "time": 0, "t": [0.45, 0, 0] }, { "time": 0.4, "t": [0.65, 0.1, 0] },
+                { "time": 0.6, "t": [0.65, -0.1, 0] }, { "time": 1, "t": [0.45, 0, 0] } ])";
+    const std::string six =
+        R"("keys": [ { "time": 0, "t": [0.45, 0, 0] }, { "time": 0.2, "t": [0.6, 0.1, 0] },
+                { "time": 0.4, "t": [0.65, 0.1, 0] }, { "time": 0.6, "t": [0.65, -0.1, 0] },
+                { "time": 0.8, "t": [0.6, -0.1, 0] }, { "time": 1, "t": [0.45, 0, 0] } ])";
+    ASSERT_NE(text.find(keys), std::string::npos);
+    text.replace(text.find(keys), keys.size(), six);
+    std::string edited = text;
+    const std::string key1 = R"({ "time": 0.2, "t": [0.6, 0.1, 0] })";
+    edited.replace(edited.find(key1), key1.size(), R"({ "time": 0.2, "t": [0.6, 0.2, 0] })");
+    FilmTiming timing;
+    timing.fps = 10.0;
+    const auto before = play(parseStrokeScript(text, "six.json"), timing);
+    const auto after = play(parseStrokeScript(edited, "edited.json"), timing);
+    ASSERT_EQ(before.size(), 11u);
+    ASSERT_EQ(after.size(), 11u);
+    for (std::size_t n : {2, 3, 4, 6})
+        EXPECT_GT(test::differingVoxels(*before.at(n), *after.at(n)), 0u) << "frame " << n;
+    for (std::size_t n : {1, 5, 7, 8, 9, 10, 11})
+        EXPECT_EQ(test::differingVoxels(*before.at(n), *after.at(n)), 0u) << "frame " << n;
 }
