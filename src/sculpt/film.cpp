@@ -119,6 +119,7 @@ void playFilm(Sculptor& sculptor, const StrokeScript& script, const FilmTiming& 
             continue;
         }
         const auto parts = planStroke(sculptor.grid(), script.strokes[i]);
+        if (parts.empty()) start += durations[i]; // (a stroke that deforms nothing still lasts)
         const double each = durations[i] / double(parts.size());
         for (std::size_t k = 0; k < parts.size() && frame <= last; ++k) {
             const StepDeformation& part = *parts[k];
