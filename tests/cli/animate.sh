@@ -132,5 +132,8 @@ refuses "sweepers-cli: $tmp/file/h_01.vdb: cannot create its directory (Not a di
 sed 's/"duration": 1.2/"duration": -1/' "$film" >"$tmp/negative.json"
 refuses "sweepers-cli: $tmp/negative.json: /strokes/0/duration: must be positive (got -1)" \
   animate "$tmp/negative.json" -o "$tmp/bad/h_#.vdb"
+sed 's/"time": 1.5/"time": 0.4/' "$data/animation/keyframed_grab.json" >"$tmp/unordered.json"
+refuses "sweepers-cli: $tmp/unordered.json: /strokes/0/keys/3/time: keys must come in increasing time (this one is at 0.4, the one before at 1)" \
+  animate "$tmp/unordered.json" -o "$tmp/bad/h_#.vdb"
 [ ! -e "$tmp/bad" ] || fail "a refused film left $(ls -R "$tmp/bad")"
 echo "animate: all checks passed"
