@@ -496,14 +496,8 @@ std::pair<std::size_t, std::size_t> parseFrameRange(const std::string& text, std
 // so an interrupted film resumes: frames already written for the same script, timing and
 // voxel size are kept.
 int runAnimate(const AnimateArgs& a) {
-    const StrokeScript script = readStrokeScript(a.script);
-    std::string text;
-    {
-        std::ifstream in(a.script, std::ios::binary);
-        std::ostringstream ss;
-        ss << in.rdbuf();
-        text = ss.str();
-    }
+    std::string text; // the script as parsed: its digest stamps the frames
+    const StrokeScript script = readStrokeScript(a.script, &text);
     if (a.voxelSize != 0.0 && !(a.voxelSize > 0.0 && std::isfinite(a.voxelSize)))
         throw std::runtime_error("--voxel-size must be a positive number");
     FilmTiming timing;
@@ -551,7 +545,7 @@ int runAnimate(const AnimateArgs& a) {
         const std::optional<FrameStamp> on = readFrameStamp(path);
         const FrameStamp want = stampOf(n);
         if (!on || on->frame != want.frame || on->time != want.time || on->fps != want.fps ||
-            on->script != want.script || readLevelSet(path)->voxelSize()[0] != h)
+            on->script != want.script || on->voxelSize != h)
             throw std::runtime_error(path + ": not frame " + std::to_string(n) +
                                      " of this film (another script, timing or voxel size); "
                                      "--force overwrites it");
@@ -570,11 +564,10 @@ int runAnimate(const AnimateArgs& a) {
                 if (meshFile) meshFile->commit();
             },
             [&](std::size_t n) { return !kept[n]; },
-            [&](std::size_t done, std::size_t all) {
+            [&](std::size_t done, std::size_t) {
                 if (!a.quiet)
                     std::fprintf(stderr, "\ranimating %s: frame %zu / %zu", a.script.c_str(),
                                  first + done - 1, last);
-                (void)all;
             });
     } catch (const Cancelled&) {
         if (!a.quiet) std::fprintf(stderr, "\n");

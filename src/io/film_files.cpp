@@ -71,7 +71,8 @@ std::optional<FrameStamp> readFrameStamp(const std::string& path) {
     const auto fps = grid->getMetadata<openvdb::DoubleMetadata>("fps");
     const auto script = grid->getMetadata<openvdb::StringMetadata>("script");
     if (!frame || !time || !fps || !script) return std::nullopt;
-    return FrameStamp{frame->value(), time->value(), fps->value(), script->value()};
+    return FrameStamp{frame->value(), time->value(), fps->value(), script->value(),
+                      grid->voxelSize()[0]};
 }
 
 } // namespace sweepers

@@ -24,7 +24,8 @@ struct FrameStamp {
     int frame = 0;
     double time = 0.0; // seconds
     double fps = 0.0;
-    std::string script; // scriptDigest of the script played
+    std::string script;     // scriptDigest of the script played
+    double voxelSize = 0.0; // of the level set (read back; not written as a stamp)
 };
 
 // A digest of a script's text: 16 hex digits (64-bit FNV-1a), the same on every machine.
@@ -37,8 +38,9 @@ std::string scriptDigest(const std::string& text);
 AtomicWrite prepareFrame(const Grid& grid, const FrameStamp& stamp, const std::string& fogName,
                          const std::string& path);
 
-// The stamp of a frame file (read in a child process, io/isolated_read.h); nullopt when the
-// file holds no usable level set or its level set no stamp.
+// The stamp of a frame file and its voxel size (read in a child process,
+// io/isolated_read.h); nullopt when the file holds no usable level set or its level set no
+// stamp.
 std::optional<FrameStamp> readFrameStamp(const std::string& path);
 
 } // namespace sweepers

@@ -574,12 +574,13 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
     return s;
 }
 
-StrokeScript readStrokeScript(const std::string& path) {
+StrokeScript readStrokeScript(const std::string& path, std::string* text) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw ScriptError(path + ": cannot open the file");
     std::ostringstream ss;
     ss << in.rdbuf();
     if (in.bad()) throw ScriptError(path + ": cannot read the file");
+    if (text) *text = ss.str();
     return parseStrokeScript(ss.str(), path, directoryOf(path));
 }
 

@@ -35,8 +35,8 @@ class ScriptError : public std::runtime_error {
 StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
                                const std::string& baseDir = "");
 // Read a file (its baked tools relative to it); a missing or unreadable file is a
-// ScriptError too.
-StrokeScript readStrokeScript(const std::string& path);
+// ScriptError too. `text`, if given, receives the file's text as it was parsed.
+StrokeScript readStrokeScript(const std::string& path, std::string* text = nullptr);
 // Serialize (numbers round-trip exactly): pretty-printed with `indent` spaces and a final
 // line break, or on one line without a line break when indent < 0.
 std::string formatStrokeScript(const StrokeScript& script, int indent = 2);

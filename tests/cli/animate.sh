@@ -118,6 +118,8 @@ refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another s
   animate "$data/horn.json" -o "$tmp/f/horn_####.vdb" --fps 6 --voxel-size $h
 refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing or voxel size); --force overwrites it" \
   animate "$film" -o "$tmp/f/horn_####.vdb" --fps 24 --voxel-size $h
+refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing or voxel size); --force overwrites it" \
+  animate "$film" -o "$tmp/f/horn_####.vdb" --fps 6 --voxel-size 0.0625
 refuses "sweepers-cli: $tmp/bad/horn.vdb: a frame pattern needs a run of '#' for the frame number (for example frames/shape_####.vdb)" \
   animate "$film" -o "$tmp/bad/horn.vdb"
 refuses "sweepers-cli: $tmp/bad/h_##_##.vdb: a frame pattern holds one run of '#', not two" \
