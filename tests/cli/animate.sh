@@ -97,15 +97,8 @@ grep -q "wrote frames 1-13 of 13 (2 s at 6 fps) to $tmp/f/horn_####.vdb, 12 kept
 echo "resumed: 12 frames kept, frame 4 made again"
 
 # --- Ctrl-C: the frames written are whole and kept ---------------------------------------
-"$cli" animate "$film" -o "$tmp/c/horn_####.vdb" --fps 6 --voxel-size $h -q 2>"$tmp/err" &
-pid=$!
-for _ in $(seq 1 400); do
-  [ "$(ls "$tmp/c" 2>/dev/null | grep -c 'vdb$')" -ge 3 ] && break
-  sleep 0.025
-done
-kill -INT "$pid"
-rc=0
-wait "$pid" || rc=$?
+stopped INT "$tmp/err" '[ "$(ls "$tmp/c" 2>/dev/null | grep -c "vdb$")" -ge 3 ]' \
+  animate "$film" -o "$tmp/c/horn_####.vdb" --fps 6 --voxel-size $h -q
 [ "$rc" = 130 ] || fail "animate stopped by SIGINT exited $rc"
 grep -qx "sweepers-cli: interrupted; the frames written are kept (the same command resumes the film)" \
   "$tmp/err" || fail "SIGINT: $(cat "$tmp/err")"

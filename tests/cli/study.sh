@@ -140,15 +140,8 @@ print("plots: convergence.png 1280x960 and a valid convergence.svg")
 PY
 
 # --- resuming after a SIGKILL ------------------------------------------------------------
-"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/64 \
-  -q &
-pid=$!
-for _ in $(seq 1 400); do
-  [ -f "$tmp/killed/study.csv" ] && [ "$(wc -l <"$tmp/killed/study.csv")" -ge 3 ] && break
-  sleep 0.025
-done
-kill -9 "$pid" 2>/dev/null || true
-wait "$pid" 2>/dev/null || true
+stopped KILL "$tmp/killed.err" '[ -f "$tmp/killed/study.csv" ] && [ "$(wc -l <"$tmp/killed/study.csv")" -ge 3 ]' \
+  study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/64 -q
 done_rows=$(($(wc -l <"$tmp/killed/study.csv") - 1))
 [ "$done_rows" -ge 2 ] || fail "the study wrote $done_rows rows before it was killed"
 stamp() { stat -c %y "$tmp/killed/trilinear_16.vdb" "$tmp/killed/trilinear_32.vdb"; }
@@ -163,16 +156,8 @@ if ls "$tmp/killed" | grep -q "tmp-"; then fail "temporary files left: $(ls "$tm
 echo "resumed after SIGKILL: $done_rows of 3 runs reused"
 
 # --- Ctrl-C: the finished runs are kept and said ------------------------------------------
-"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/stopped" --voxel-sizes 1/16,1/128 -q \
-  2>"$tmp/stopped.err" &
-pid=$!
-for _ in $(seq 1 400); do
-  [ -f "$tmp/stopped/study.csv" ] && [ "$(wc -l <"$tmp/stopped/study.csv")" -ge 2 ] && break
-  sleep 0.025
-done
-kill -INT "$pid"
-rc=0
-wait "$pid" || rc=$?
+stopped INT "$tmp/stopped.err" '[ -f "$tmp/stopped/study.csv" ] && [ "$(wc -l <"$tmp/stopped/study.csv")" -ge 2 ]' \
+  study "$data/studies/rigid_motion.json" -o "$tmp/stopped" --voxel-sizes 1/16,1/128 -q
 [ "$rc" = 130 ] || fail "a study stopped by SIGINT exited $rc"
 grep -q "interrupted after 1 of 2 runs; they are in $tmp/stopped/study.csv" "$tmp/stopped.err" ||
   fail "SIGINT: $(cat "$tmp/stopped.err")"
