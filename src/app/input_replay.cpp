@@ -3,11 +3,34 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <stdexcept>
 
+#define GLFW_INCLUDE_NONE // key codes only: no window here
+#include <GLFW/glfw3.h>
 #include <nlohmann/json.hpp>
 
 namespace sweepers {
+
+namespace {
+
+// GLFW's code for a key named as in a replay file: a character (letters as capitals, as
+// GLFW numbers them) or the name of a key without one.
+int keyCode(const std::string& k) {
+    static const std::map<std::string, int> named{
+        {"space", GLFW_KEY_SPACE}, {"escape", GLFW_KEY_ESCAPE}, {"left", GLFW_KEY_LEFT},
+        {"right", GLFW_KEY_RIGHT}, {"up", GLFW_KEY_UP},         {"down", GLFW_KEY_DOWN},
+        {"home", GLFW_KEY_HOME},   {"end", GLFW_KEY_END}};
+    if (k.size() == 1 && std::isgraph(static_cast<unsigned char>(k[0])))
+        return std::toupper(static_cast<unsigned char>(k[0]));
+    const auto it = named.find(k);
+    if (it == named.end())
+        throw std::runtime_error("key must be one character or one of space, escape, left, "
+                                 "right, up, down, home, end");
+    return it->second;
+}
+
+} // namespace
 
 std::vector<InputEvent> readInputEvents(const std::string& path) {
     std::ifstream in(path);
@@ -55,10 +78,7 @@ std::vector<InputEvent> readInputEvents(const std::string& path) {
                 ev.y = number("y");
             } else if (type == "key") {
                 ev.type = InputEvent::Type::Key;
-                const std::string k = e.at("key").get<std::string>();
-                if (k.size() != 1 || !std::isalnum(static_cast<unsigned char>(k[0])))
-                    throw std::runtime_error("key must be one letter or digit");
-                ev.key = std::toupper(static_cast<unsigned char>(k[0]));
+                ev.key = keyCode(e.at("key").get<std::string>());
                 ev.ctrl = e.value("ctrl", false);
                 ev.shift = e.value("shift", false);
             } else if (type == "scroll") {

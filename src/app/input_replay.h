@@ -6,6 +6,8 @@
 //       { "frame": 4, "type": "move",    "x": 420, "y": 290 },
 //       { "frame": 5, "type": "release", "button": "left", "x": 420, "y": 290 },
 //       { "frame": 7, "type": "key",     "key": "z", "ctrl": true, "shift": false },
+//       { "frame": 8, "type": "key",     "key": "space" },  (or escape, left, right, up,
+//                                                              down, home, end; or "." ...)
 //       { "frame": 8, "type": "scroll",  "dy": -1 },
 //       { "frame": 9, "type": "drop",    "path": "shape.vdb" } ] }   (a file dropped on it)
 //
@@ -24,7 +26,7 @@ struct InputEvent {
     Type type = Type::Move;
     int button = 0; // 0 left, 1 right, 2 middle
     double x = 0, y = 0, dy = 0;
-    int key = 0; // an uppercase ASCII letter or digit, or a GLFW key code for others
+    int key = 0; // GLFW's key code: for a character key, its ASCII code (letters in capitals)
     bool ctrl = false, shift = false;
     std::string path; // Drop
 };

@@ -29,6 +29,11 @@ static int run(int argc, char** argv) {
     app.add_flag("--replay-live", o.replayLive,
                  "replay at frame pace, not waiting for the sculpting (events are coalesced as "
                  "when a user drags)");
+    app.add_option("--record-frames", o.recordFrames,
+                   "play the history as a film (24 fps, a quarter second per path segment) and "
+                   "write each frame as DIR/frame_0001.png ..., then exit");
+    app.add_option("--save-frame", o.saveFrame,
+                   "write the frame the timeline shows (.vdb, or a mesh) when the window closes");
     app.add_flag("--hide-ui", o.hideUi, "draw no panels");
     app.add_flag("--latency-report", o.latencyReport,
                  "print stroke latency (drag event to mesh on screen) by stage at exit");

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <future>
 #include <memory>
@@ -28,11 +29,13 @@
 #include "app/input_replay.h"
 #include "app/sculpt_controller.h"
 #include "app/session.h"
+#include "app/timeline.h"
 #include "core/format.h"
 #include "core/statistics.h"
 #include "core/stopwatch.h"
 #include "io/atomic_file.h"
 #include "io/mesh_file.h"
+#include "io/vdb_file.h"
 #include "levelset/band.h"
 
 namespace sweepers {
@@ -44,8 +47,8 @@ namespace {
 class Modeler {
   public:
     Modeler(const ModelerOptions& o, GLFWwindow* w)
-        : batch_(!o.replayInput.empty() || !o.screenshot.empty()), ctl_(batch_ && !o.replayLive),
-          opt_(o), win_(w) {
+        : batch_(!o.replayInput.empty() || !o.screenshot.empty() || !o.recordFrames.empty()),
+          ctl_(batch_ && !o.replayLive), opt_(o), win_(w) {
         renderer_ = std::make_unique<GlRenderer>(findShaderDir(o.argv0));
         std::snprintf(path_, sizeof path_, "%s", o.open.empty() ? "untitled.vdb" : o.open.c_str());
         voxelSizeInput_ = float(o.voxelSize);
@@ -108,6 +111,7 @@ class Modeler {
                 ctl_.step();
                 takeFinished();
             }
+            stepFilm();
             if (session_) {
                 const std::string problem = session_->takeError();
                 if (!problem.empty()) {
@@ -117,10 +121,9 @@ class Modeler {
             }
             const auto drawStart = Clock::now();
             draw();
-            if (batch_ && !job_ && !ctl_.busy() && ctl_.drag() == DragKind::None && replay.over()) {
-                if (!opt_.screenshot.empty()) screenshot(opt_.screenshot);
-                glfwSetWindowShouldClose(win_, GLFW_TRUE);
-            }
+            if (batch_ && !job_ && !ctl_.busy() && ctl_.drag() == DragKind::None && replay.over() &&
+                filmSettled())
+                batchStep();
             if (!job_) replay.endFrame(ctl_);
             glfwSwapBuffers(win_);
             if (measuring_) {
@@ -150,6 +153,11 @@ class Modeler {
         if (!opt_.latencyCsv.empty()) writeLatencyCsv(opt_.latencyCsv);
         if (!opt_.saveVdb.empty()) doc_->saveVdb(opt_.saveVdb);
         if (!opt_.saveScript.empty()) doc_->saveScript(opt_.saveScript);
+        if (!opt_.saveFrame.empty()) {
+            if (!film_ || !film_->grid())
+                throw std::runtime_error("--save-frame: the timeline shows no frame");
+            saveFrame(opt_.saveFrame);
+        }
         // A clean end: the user saved or chose to discard (or a batch run wrote its files).
         if (session_) session_->close();
         return 0;
@@ -170,6 +178,11 @@ class Modeler {
             if (key == GLFW_KEY_ESCAPE) job_->stop->interrupt();
             return;
         }
+        if (!ctrl && key == 'V') {
+            film_ ? closeFilm() : openFilm();
+            return;
+        }
+        if (film_ && filmKey(key, ctrl)) return;
         if (ctrl && !shift && key == 'Z' && doc_->undoNeedsReplay() && !ctl_.busy() &&
             ctl_.drag() == DragKind::None) {
             undoByReplay();
@@ -203,6 +216,7 @@ class Modeler {
     }
 
     void setDocument(std::unique_ptr<Document> doc, const Adoption& adopt = {}) {
+        closeFilm();
         ctl_.setDocument(nullptr);
         doc_ = std::move(doc);
         doc_->setUndoBudget(opt_.undoBudgetBytes);
@@ -291,6 +305,161 @@ class Modeler {
         }
     }
 
+    // --- the timeline: the history played as a film on a grid of its own -------------
+    void openFilm() {
+        if (film_ || !doc_ || job_ || ctl_.busy() || ctl_.drag() != DragKind::None) return;
+        film_ = std::make_unique<Timeline>(*doc_);
+        ctl_.setSculpting(false);
+        status_ = "film of " + std::to_string(doc_->script().strokes.size()) +
+                  " strokes: " + std::to_string(film_->frameCount()) + " frames at " +
+                  formatNumber(film_->fps()) + " fps; the document is unchanged";
+    }
+
+    void closeFilm() {
+        if (!film_) return;
+        film_.reset();
+        ctl_.setSculpting(true);
+        if (doc_) renderer_->update(doc_->mesher(), MeshChanges{true, {}});
+    }
+
+    // Keys while the film is open; false: the key is not the timeline's.
+    bool filmKey(int key, bool ctrl) {
+        if (ctrl) return key == 'Z'; // nothing changes the document meanwhile
+        switch (key) {
+        case GLFW_KEY_ESCAPE:
+            closeFilm();
+            return true;
+        case GLFW_KEY_SPACE:
+            film_->playing() ? film_->pause() : film_->play();
+            return true;
+        case GLFW_KEY_COMMA:
+            film_->pause();
+            film_->scrubTo(std::max<std::size_t>(film_->wanted(), 2) - 1);
+            return true;
+        case GLFW_KEY_PERIOD:
+            film_->pause();
+            film_->scrubTo(film_->wanted() + 1);
+            return true;
+        case GLFW_KEY_HOME:
+            film_->pause();
+            film_->scrubTo(1);
+            return true;
+        case GLFW_KEY_END:
+            film_->pause();
+            film_->scrubTo(film_->frameCount());
+            return true;
+        default:
+            return false;
+        }
+    }
+
+    void stepFilm() {
+        if (!film_) return;
+        if (batch_) film_->wait(); // batch runs make every frame asked for
+        if (film_->step()) filmVolume_ = film_->mesher()->enclosedVolume();
+        const std::string problem = film_->takeMessage();
+        if (problem.empty()) return;
+        if (batch_) throw std::runtime_error(problem);
+        fail(problem);
+        closeFilm();
+    }
+
+    bool filmSettled() const {
+        return !film_ || (!film_->busy() && film_->shown() == film_->wanted());
+    }
+
+    void saveFrame(const std::string& path) {
+        if (!film_ || !film_->grid()) throw std::runtime_error("the timeline shows no frame yet");
+        if (isMeshPath(path))
+            writeMesh(film_->mesher()->weld(), path);
+        else
+            writeLevelSet(*film_->grid(), path);
+    }
+
+    // A batch run with nothing left to replay: records the film's frames one by one (each
+    // drawn before it is read back), takes the screenshot, and closes the window.
+    void batchStep() {
+        if (!opt_.recordFrames.empty() && recordNext_ == 0) {
+            openFilm();
+            if (!film_) throw std::runtime_error("--record-frames: the film cannot be opened");
+            recordNext_ = 1;
+            film_->scrubTo(1);
+            return;
+        }
+        if (recordNext_ != 0 && recordNext_ <= film_->frameCount()) {
+            const std::size_t count = film_->frameCount();
+            const int digits = std::max(4, int(std::to_string(count).size()));
+            char name[32];
+            std::snprintf(name, sizeof name, "frame_%0*zu.png", digits, recordNext_);
+            screenshot((std::filesystem::path(opt_.recordFrames) / name).string());
+            if (++recordNext_ <= count) {
+                film_->scrubTo(recordNext_);
+                return;
+            }
+            std::fprintf(stderr, "sweepers: wrote %zu frames to %s\n", count,
+                         opt_.recordFrames.c_str());
+        }
+        if (!opt_.screenshot.empty()) screenshot(opt_.screenshot);
+        glfwSetWindowShouldClose(win_, GLFW_TRUE);
+    }
+
+    void filmPanel() {
+        const ImVec2 size = ImGui::GetIO().DisplaySize;
+        ImGui::SetNextWindowPos(ImVec2(size.x * 0.5f, size.y - 10.0f), ImGuiCond_Always,
+                                ImVec2(0.5f, 1.0f));
+        ImGui::SetNextWindowSize(ImVec2(std::min(size.x - 20.0f, 720.0f), 0.0f), ImGuiCond_Always);
+        ImGui::Begin("Film of the history (V)", nullptr,
+                     ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoResize);
+        Timeline& f = *film_;
+        int frame = int(f.wanted());
+        ImGui::SetNextItemWidth(-1.0f);
+        if (ImGui::SliderInt("##frame", &frame, 1, int(f.frameCount()), "frame %d")) {
+            f.pause();
+            f.scrubTo(std::size_t(frame));
+        }
+        if (ImGui::Button(f.playing() ? "Pause (space)" : "Play (space)"))
+            filmKey(GLFW_KEY_SPACE, false);
+        ImGui::SameLine();
+        if (ImGui::Button("|< Home")) filmKey(GLFW_KEY_HOME, false);
+        ImGui::SameLine();
+        if (ImGui::Button("< ,")) filmKey(GLFW_KEY_COMMA, false);
+        ImGui::SameLine();
+        if (ImGui::Button(". >")) filmKey(GLFW_KEY_PERIOD, false);
+        ImGui::SameLine();
+        if (ImGui::Button("End >|")) filmKey(GLFW_KEY_END, false);
+        ImGui::SameLine();
+        static const float speeds[] = {0.25f, 0.5f, 1.0f, 2.0f, 4.0f};
+        int speed = 2;
+        for (int k = 0; k < 5; ++k)
+            if (double(speeds[k]) == f.speed()) speed = k;
+        ImGui::SetNextItemWidth(90.0f);
+        if (ImGui::Combo("speed", &speed,
+                         "0.25x\0"
+                         "0.5x\0"
+                         "1x\0"
+                         "2x\0"
+                         "4x\0"))
+            f.setSpeed(speeds[speed]);
+        ImGui::Text("frame %zu of %zu, %.2f of %.2f s, volume %.5f%s", f.shown(), f.frameCount(),
+                    filmFrameTime(std::max<std::size_t>(f.shown(), 1), f.seconds(), f.fps()),
+                    f.seconds(), filmVolume_, f.busy() ? "  (making a frame...)" : "");
+        ImGui::BeginDisabled(f.busy() || !f.grid());
+        if (ImGui::Button("Export this frame")) {
+            try {
+                saveFrame(path_);
+                status_ = std::string("wrote the frame to ") + path_;
+            } catch (const std::exception& e) {
+                fail(e.what());
+            }
+        }
+        ImGui::EndDisabled();
+        ImGui::SameLine();
+        ImGui::TextDisabled("to the file in the panel (.vdb or a mesh)");
+        ImGui::SameLine();
+        if (ImGui::Button("Close (V)")) closeFilm();
+        ImGui::End();
+    }
+
     void confirm(const std::string& question, std::function<void()> action) {
         confirmText_ = question;
         confirmAction_ = std::move(action);
@@ -366,7 +535,13 @@ class Modeler {
     }
 
     void scene(int fw, int fh) {
-        if (!ctl_.busy()) {
+        if (film_) {
+            if (const SurfaceMesher* m = film_->mesher()) {
+                const auto t0 = Clock::now();
+                renderer_->update(*m, film_->takeMeshChanges());
+                uploadMs_ = 1e3 * secondsSince(t0);
+            }
+        } else if (!ctl_.busy()) {
             const auto t0 = Clock::now();
             renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
             uploadMs_ = 1e3 * secondsSince(t0);
@@ -405,6 +580,7 @@ class Modeler {
         ImGui_ImplGlfw_NewFrame();
         ImGui::NewFrame();
         if (doc_ && !opt_.hideUi) mainPanel();
+        if (film_ && !opt_.hideUi) filmPanel();
         if (job_) {
             const ImVec2 size = ImGui::GetIO().DisplaySize;
             ImGui::SetNextWindowPos(ImVec2(size.x * 0.5f, size.y * 0.5f), ImGuiCond_Always,
@@ -473,11 +649,14 @@ class Modeler {
         ImGui::Text("undo: %zu edits in %.1f of %.0f MB, %zu more by replay", info_.undoCount,
                     double(info_.undoBytes) / (1 << 20), double(doc_->undoBudget()) / (1 << 20),
                     doc_->droppedCount());
-        // Nothing that changes the document while a drag is being sculpted.
-        ImGui::BeginDisabled(ctl_.busy() || sculpting);
+        // Nothing that changes the document while a drag is being sculpted, or while the
+        // film of its history plays.
+        ImGui::BeginDisabled(ctl_.busy() || sculpting || film_);
         if (ImGui::Button("Undo")) onKey('Z', true, false);
         ImGui::SameLine();
         if (ImGui::Button("Redo")) onKey('Z', true, true);
+        ImGui::SameLine();
+        if (ImGui::Button("Film of the history (V)")) openFilm();
         ImGui::Separator();
         ImGui::InputText("file", path_, sizeof path_);
         if (ImGui::Button("Open")) openFile(path_);
@@ -637,6 +816,9 @@ class Modeler {
     std::unique_ptr<Session> session_; // declared before doc_: it outlives the document
     std::unique_ptr<Document> doc_;
     std::unique_ptr<GlRenderer> renderer_;
+    std::unique_ptr<Timeline> film_; // open: the window shows its frame, not the document
+    double filmVolume_ = 0.0;
+    std::size_t recordNext_ = 0; // --record-frames: the next frame to write (0: not begun)
     std::string offerRecovery_, offerText_; // an interrupted session the user has not
                                             // decided about, and what the offer says
     double groundY_ = -1.0;
@@ -722,6 +904,13 @@ struct WindowSession {
 } // namespace
 
 int runModeler(const ModelerOptions& o) {
+    if (!o.recordFrames.empty()) {
+        std::error_code ec;
+        std::filesystem::create_directories(o.recordFrames, ec);
+        if (ec || !std::filesystem::is_directory(o.recordFrames))
+            throw std::runtime_error(o.recordFrames + ": cannot make the directory for the frames" +
+                                     (ec ? ": " + ec.message() : ""));
+    }
     glfwSetErrorCallback(errorCallback);
     if (!glfwInit())
         throw std::runtime_error(

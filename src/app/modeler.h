@@ -10,11 +10,15 @@ struct ModelerOptions {
     std::string open; // a .vdb or a stroke script (.json); empty: a unit sphere
     double voxelSize = 1.0 / 64;
     int width = 1280, height = 800;
-    std::string screenshot;     // render, write this PNG and exit (after the replay, if any)
-    std::string replayInput;    // events to replay; the window closes after the last one
-    bool replayLive = false;    // replay at frame pace, not waiting for the sculpting
-    std::string saveVdb;        // written when the window closes (for tests and batch use)
-    std::string saveScript;     // the recorded stroke script, written when the window closes
+    std::string screenshot;  // render, write this PNG and exit (after the replay, if any)
+    std::string replayInput; // events to replay; the window closes after the last one
+    bool replayLive = false; // replay at frame pace, not waiting for the sculpting
+    std::string saveVdb;     // written when the window closes (for tests and batch use)
+    std::string saveScript;  // the recorded stroke script, written when the window closes
+    // The history played as a film (the timeline): one PNG per frame written here
+    // (frame_0001.png, ...), after the replay if any, then the window closes.
+    std::string recordFrames;
+    std::string saveFrame;      // the frame the timeline shows, written when the window closes
     bool hideUi = false;        // no panels (clean screenshots)
     bool latencyReport = false; // print per-segment latency by stage when the window closes
     std::string latencyCsv;     // ... and write every segment's figures here (ms)

@@ -65,7 +65,7 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
         drag_ = DragKind::Pan;
         return;
     }
-    const auto hit = pick(x, y);
+    const auto hit = sculpting_ ? pick(x, y) : std::nullopt;
     if (!hit) {
         drag_ = DragKind::Orbit;
         return;
@@ -336,7 +336,7 @@ std::optional<glm::dvec3> SculptController::toolCentre() const {
         if (settings_.mode == SculptMode::Clay || topologyMode()) return std::nullopt;
         return toGlm(last_.t);
     }
-    if (drag_ == DragKind::None && !busy()) return pick(cursorX_, cursorY_);
+    if (drag_ == DragKind::None && !busy() && sculpting_) return pick(cursorX_, cursorY_);
     return std::nullopt;
 }
 

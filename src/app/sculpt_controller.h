@@ -121,6 +121,9 @@ class SculptController {
     void useToolFile(const std::string& path);
     // Back to the ball.
     void useBall();
+    // Off: a left drag turns the view wherever it starts and no tool is drawn (the
+    // modeler's timeline shows another grid than the document's).
+    void setSculpting(bool on) { sculpting_ = on; }
     // Looks at the whole shape.
     void frameView();
     double volume() const { return volume_; }
@@ -149,7 +152,7 @@ class SculptController {
     void stepTopologyDrag();
 
     Document* doc_ = nullptr;
-    bool waitEach_ = false;
+    bool waitEach_ = false, sculpting_ = true;
     int width_ = 1, height_ = 1;
     OrbitCamera camera_;
     ToolSettings settings_;

@@ -493,10 +493,11 @@ std::pair<std::size_t, std::size_t> parseFrameRange(const std::string& text, std
 }
 
 // Plays a script as a film (sculpt/film.h) and writes one VDB per frame, each atomically,
-// so an interrupted film resumes: frames already written for the same script, timing and
-// voxel size are kept.
+// so an interrupted film resumes: a frame on disk made of the same things (frameDigests),
+// at the same time, frame rate and voxel size is kept, so an edit rewrites only the frames
+// it changes.
 int runAnimate(const AnimateArgs& a) {
-    std::string text; // the script as parsed: its digest stamps the frames
+    std::string text; // the script as parsed: what the frames are made of
     const StrokeScript script = readStrokeScript(a.script, &text);
     if (a.voxelSize != 0.0 && !(a.voxelSize > 0.0 && std::isfinite(a.voxelSize)))
         throw std::runtime_error("--voxel-size must be a positive number");
@@ -531,24 +532,26 @@ int runAnimate(const AnimateArgs& a) {
     Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop, a.force),
                       options);
     const double h = sculptor.grid().voxelSize()[0];
-    const std::string digest = scriptDigest(text);
+    const std::vector<std::string> digests = frameDigests(text, script, timing, a.fog);
     auto stampOf = [&](std::size_t n) {
-        return FrameStamp{int(n), filmFrameTime(n, seconds, timing.fps), timing.fps, digest};
+        return FrameStamp{int(n), filmFrameTime(n, seconds, timing.fps), timing.fps, digests[n]};
     };
-    // Frames on disk from an earlier run of the same film are kept; anything else in their
-    // place is refused, unless --force, before any work starts.
+    // Frames on disk made of the same things are kept; anything else in their place is
+    // refused, unless --force overwrites it, before any work starts.
     std::vector<char> kept(last + 1, 0);
     std::size_t keptCount = 0;
-    for (std::size_t n = first; n <= last && !a.force; ++n) {
+    for (std::size_t n = first; n <= last; ++n) {
         const std::string path = framePath(a.output, n);
         if (!std::filesystem::exists(path)) continue;
         const std::optional<FrameStamp> on = readFrameStamp(path);
         const FrameStamp want = stampOf(n);
         if (!on || on->frame != want.frame || on->time != want.time || on->fps != want.fps ||
-            on->script != want.script || on->voxelSize != h)
+            on->script != want.script || on->voxelSize != h) {
+            if (a.force) continue;
             throw std::runtime_error(path + ": not frame " + std::to_string(n) +
                                      " of this film (another script, timing or voxel size); "
                                      "--force overwrites it");
+        }
         kept[n] = a.mesh.empty() || std::filesystem::exists(framePath(a.mesh, n));
         keptCount += kept[n];
     }

@@ -1,9 +1,12 @@
 #include "io/film_files.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <stdexcept>
 
+#include <nlohmann/json.hpp>
 #include <openvdb/tools/LevelSetUtil.h>
 
 #include "io/vdb_file.h"
@@ -38,6 +41,73 @@ std::string scriptDigest(const std::string& text) {
     char hex[17];
     std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
     return hex;
+}
+
+std::vector<std::string> frameDigests(const std::string& scriptText, const StrokeScript& script,
+                                      const FilmTiming& timing, const std::string& extra) {
+    const std::vector<double> durations = strokeDurations(script, timing);
+    double seconds = 0.0;
+    for (double d : durations)
+        seconds += d;
+    const std::size_t count = filmFrameCount(seconds, timing.fps);
+    nlohmann::json header = nlohmann::json::parse(scriptText);
+    const nlohmann::json strokes = header.at("strokes");
+    header.erase("strokes");
+    // A keyed stroke with only the keys given (their places in the list kept).
+    auto withKeys = [](nlohmann::json stroke, const std::vector<std::size_t>& which) {
+        nlohmann::json kept = nlohmann::json::array();
+        for (std::size_t k : which)
+            kept.push_back({{"key", k}, {"is", stroke["keys"][k]}});
+        stroke["keys"] = kept;
+        return stroke;
+    };
+    // The keys that shape a keyed stroke's spline at time u in it: on the piece between
+    // keys i and i + 1, the tangents at both ends reach keys i - 1 and i + 2 (at the last
+    // key's time, the last piece's).
+    auto keysAt = [](const nlohmann::json& stroke, double u) {
+        const nlohmann::json& keys = stroke["keys"];
+        const std::size_t n = keys.size();
+        std::size_t i = 0;
+        while (i + 2 < n && keys[i + 1].at("time").get<double>() <= u)
+            ++i;
+        std::vector<std::size_t> which{0};
+        if (u <= 0.0) return which;
+        for (std::size_t k = i == 0 ? 1 : i - 1; k <= std::min(n - 1, i + 2); ++k)
+            which.push_back(k);
+        return which;
+    };
+    std::vector<std::string> digests(count + 1);
+    char number[40];
+    for (std::size_t n = 1; n <= count; ++n) {
+        const double time = filmFrameTime(n, seconds, timing.fps);
+        std::snprintf(number, sizeof number, "%.17g", time);
+        std::string made = header.dump() + "\n" + extra + "\n" + number + "\n";
+        double start = 0.0;
+        for (std::size_t i = 0; i < strokes.size(); ++i) {
+            const double end = start + durations[i];
+            const bool keyed = keyedDuration(script.strokes[i]) > 0.0;
+            // The film adds up its strokes' times its own way: a frame within a hair of a
+            // stroke's end counts as in it, with every key that can reach there.
+            const bool atEnd = std::abs(time - end) <= 1e-9 * std::max(1.0, end);
+            std::snprintf(number, sizeof number, " for %.17g", durations[i]);
+            if (time < end || atEnd) {
+                const double u = std::min(time, end) - start;
+                made += (keyed ? withKeys(strokes[i], keysAt(strokes[i], u)) : strokes[i]).dump() +
+                        number;
+                std::snprintf(number, sizeof number, " at %.17g\n", u);
+                made += number;
+                if (time < end) break;
+            } else {
+                made +=
+                    (keyed ? withKeys(strokes[i], {0, strokes[i]["keys"].size() - 1}) : strokes[i])
+                        .dump() +
+                    number + "\n";
+            }
+            start = end;
+        }
+        digests[n] = scriptDigest(made);
+    }
+    return digests;
 }
 
 AtomicWrite prepareFrame(const Grid& grid, const FrameStamp& stamp, const std::string& fogName,

@@ -8,9 +8,11 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "io/atomic_file.h"
 #include "levelset/vdb.h"
+#include "sculpt/film.h"
 
 namespace sweepers {
 
@@ -24,12 +26,23 @@ struct FrameStamp {
     int frame = 0;
     double time = 0.0; // seconds
     double fps = 0.0;
-    std::string script;     // scriptDigest of the script played
+    std::string script;     // what the frame is made of (frameDigests)
     double voxelSize = 0.0; // of the level set (read back; not written as a stamp)
 };
 
 // A digest of a script's text: 16 hex digits (64-bit FNV-1a), the same on every machine.
 std::string scriptDigest(const std::string& text);
+
+// What each frame of the film of a script (its text, as parsed into `script`) is made of,
+// as a digest: the script's grid and start, each stroke finished by the frame's time with
+// its duration, the stroke the frame falls in and the time in it, the frame's time, and
+// `extra` (what else a frame file holds). A keyed stroke counts by the keys its spline
+// depends on there (the first, and the two before and the two after the time), and once
+// finished by its first and last. Element n is frame n's (element 0 is unused). So an
+// edited key changes the digests of the frames its spline spans only, an edited stroke
+// those from its start on.
+std::vector<std::string> frameDigests(const std::string& scriptText, const StrokeScript& script,
+                                      const FilmTiming& timing, const std::string& extra = "");
 
 // Frame `stamp.frame`: the level set with the stamp as metadata (frame, time, fps, script)
 // and, when fogName is not empty, a fog volume of that name (0 outside, rising across the

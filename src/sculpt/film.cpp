@@ -65,92 +65,117 @@ double filmFrameTime(std::size_t frame, double seconds, double fps) {
     return std::min(double(frame - 1) / fps, seconds);
 }
 
-void playFilm(Sculptor& sculptor, const StrokeScript& script, const FilmTiming& timing,
-              std::size_t first, std::size_t last,
-              const std::function<void(std::size_t, double, const Grid&)>& show,
-              const std::function<bool(std::size_t)>& wanted, const Progress& progress) {
-    const std::vector<double> durations = strokeDurations(script, timing);
-    double total = 0.0;
-    for (double d : durations)
-        total += d;
-    last = std::min(last, filmFrameCount(total, timing.fps));
-    if (first < 1 || first > last) return;
-    std::size_t frame = first;
-    // Shows `frame` as the sculptor's grid is, and moves on to the next.
-    auto emit = [&](double time) {
-        if (!wanted || wanted(frame)) show(frame, time, sculptor.grid());
-        if (progress) progress(frame - first + 1, last - first + 1);
-        ++frame;
-    };
-    double start = 0.0; // of the current deformation
-    // Shows `frame` with the deformations on top of the shape so far, then takes them back.
-    auto emitWith = [&](double time, const std::vector<const StepDeformation*>& on) {
-        if (on.empty()) return emit(time);
-        sculptor.startRecording();
+FilmPlayer::FilmPlayer(Sculptor& sculptor, StrokeScript script, const FilmTiming& timing)
+    : sculptor_(sculptor), script_(std::move(script)), durations_(strokeDurations(script_, timing)),
+      fps_(timing.fps) {
+    for (double d : durations_)
+        seconds_ += d;
+    count_ = filmFrameCount(seconds_, fps_);
+}
+
+void FilmPlayer::takeBackPartial() {
+    if (!partialOn_) return;
+    sculptor_.restoreRecording();
+    sculptor_.stopRecording();
+    partialOn_ = false;
+}
+
+void FilmPlayer::finishPart() {
+    sculptor_.applySegment(*parts_[k_]);
+    start_ += durations_[i_] / double(parts_.size());
+    if (++k_ == parts_.size()) {
+        parts_.clear();
+        planned_ = false;
+        ++i_;
+    }
+}
+
+void FilmPlayer::seek(std::size_t n) {
+    if (n < shown_ || n < 1 || n > count_)
+        throw std::invalid_argument("a film player seeks forward, to a frame of the film");
+    if (n == shown_) return;
+    takeBackPartial();
+    const double time = filmFrameTime(n, seconds_, fps_);
+    // Shows the deformations on top of the shape so far until the next seek.
+    auto putOn = [this](const std::vector<const StepDeformation*>& on) {
+        sculptor_.startRecording();
+        partialOn_ = true;
         for (const StepDeformation* d : on)
-            sculptor.applySegment(*d);
-        emit(time);
-        sculptor.restoreRecording();
-        sculptor.stopRecording();
+            sculptor_.applySegment(*d);
     };
-    for (std::size_t i = 0; i < script.strokes.size() && frame <= last; ++i) {
-        if (keyedDuration(script.strokes[i]) > 0.0) {
-            // A keyed stroke: each frame from the shape the stroke starts from, by the stroke
-            // at that time (never from the frame before), then the stroke at its last key.
-            const double end = start + durations[i];
-            while (frame <= last) {
-                const double time = filmFrameTime(frame, total, timing.fps);
-                if (time >= end) break;
-                if (wanted && !wanted(frame)) {
-                    emit(time);
-                    continue;
-                }
-                const auto parts = planKeyedStroke(script.strokes[i], time - start);
+    while (i_ < script_.strokes.size()) {
+        const Stroke& stroke = script_.strokes[i_];
+        if (keyedDuration(stroke) > 0.0) {
+            // A keyed stroke: the frame is the shape the stroke starts from under the stroke
+            // at that time (never the frame before), and past it the stroke at its last key.
+            const double end = start_ + durations_[i_];
+            if (time < end) {
+                const auto parts = planKeyedStroke(stroke, time - start_);
                 std::vector<const StepDeformation*> on;
                 on.reserve(parts.size());
                 for (const auto& part : parts)
                     on.push_back(part.get());
-                emitWith(time, on);
+                putOn(on);
+                break;
             }
-            if (frame > last) break;
-            for (const auto& part : planStroke(sculptor.grid(), script.strokes[i]))
-                sculptor.applySegment(*part);
-            start = end;
+            for (const auto& part : planStroke(sculptor_.grid(), stroke))
+                sculptor_.applySegment(*part);
+            start_ = end;
+            ++i_;
             continue;
         }
-        const auto parts = planStroke(sculptor.grid(), script.strokes[i]);
-        if (parts.empty()) start += durations[i]; // (a stroke that deforms nothing still lasts)
-        const double each = durations[i] / double(parts.size());
-        for (std::size_t k = 0; k < parts.size() && frame <= last; ++k) {
-            const StepDeformation& part = *parts[k];
-            const double end = start + each;
-            // The frames inside this deformation: a sweep segment goes part of the way, any
-            // other deformation does the sub-steps due by then (a frame that rounds to all
-            // of them waits for the next deformation, which shows this one whole).
-            while (frame <= last) {
-                const double time = filmFrameTime(frame, total, timing.fps);
-                if (time >= end) break;
-                const double f = (time - start) / each;
-                std::unique_ptr<StepDeformation> partial;
-                if (f > 0.0 && (!wanted || wanted(frame))) {
-                    partial = sweptPart(script.strokes[i], k, f);
-                    if (!partial) {
-                        const long done = std::lround(f * part.steps());
-                        if (done >= part.steps()) break;
-                        if (done > 0) partial = std::make_unique<StepPrefix>(part, int(done));
-                    }
-                }
-                if (partial)
-                    emitWith(time, {partial.get()});
-                else
-                    emit(time);
+        if (!planned_) {
+            parts_ = planStroke(sculptor_.grid(), stroke);
+            k_ = 0;
+            planned_ = true;
+            if (parts_.empty()) { // a stroke that deforms nothing still lasts
+                start_ += durations_[i_];
+                planned_ = false;
+                ++i_;
+                continue;
             }
-            sculptor.applySegment(part);
-            start = end;
         }
+        const double each = durations_[i_] / double(parts_.size());
+        if (time < start_ + each) {
+            // Inside this deformation: a sweep segment goes part of the way, any other
+            // deformation does the sub-steps due by then (a frame that rounds to all of
+            // them is shown after it, at the start of the next).
+            const StepDeformation& part = *parts_[k_];
+            const double f = (time - start_) / each;
+            std::unique_ptr<StepDeformation> partial;
+            if (f > 0.0) {
+                partial = sweptPart(stroke, k_, f);
+                if (!partial) {
+                    const long done = std::lround(f * part.steps());
+                    if (done >= part.steps()) {
+                        finishPart();
+                        continue;
+                    }
+                    if (done > 0) partial = std::make_unique<StepPrefix>(part, int(done));
+                }
+            }
+            if (partial) putOn({partial.get()});
+            break;
+        }
+        finishPart();
     }
-    while (frame <= last)
-        emit(filmFrameTime(frame, total, timing.fps));
+    shown_ = n;
+}
+
+void playFilm(Sculptor& sculptor, const StrokeScript& script, const FilmTiming& timing,
+              std::size_t first, std::size_t last,
+              const std::function<void(std::size_t, double, const Grid&)>& show,
+              const std::function<bool(std::size_t)>& wanted, const Progress& progress) {
+    FilmPlayer player(sculptor, script, timing);
+    last = std::min(last, player.frameCount());
+    if (first < 1 || first > last) return;
+    for (std::size_t n = first; n <= last; ++n) {
+        if (!wanted || wanted(n)) {
+            player.seek(n);
+            show(n, filmFrameTime(n, player.seconds(), player.fps()), sculptor.grid());
+        }
+        if (progress) progress(n - first + 1, last - first + 1);
+    }
 }
 
 } // namespace sweepers

@@ -11,6 +11,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <vector>
 
 #include "sculpt/sculptor.h"
@@ -31,11 +32,47 @@ std::vector<double> strokeDurations(const StrokeScript& script, const FilmTiming
 std::size_t filmFrameCount(double seconds, double fps);
 double filmFrameTime(std::size_t frame, double seconds, double fps);
 
+// The film played on a sculptor's grid up to any frame, and on from there: a timeline's
+// play head. seek(n) leaves the grid showing frame n (a frame inside a deformation holds the
+// partial deformation on top of the shape so far, taken back by the next seek); going back
+// needs a new player on the start shape.
+class FilmPlayer {
+  public:
+    // The sculptor's grid is the script's start shape. Throws std::invalid_argument for a
+    // timing that is not positive and finite.
+    FilmPlayer(Sculptor& sculptor, StrokeScript script, const FilmTiming& timing);
+    std::size_t frameCount() const { return count_; }
+    double seconds() const { return seconds_; }
+    double fps() const { return fps_; }
+    // The frame the grid shows (0 before the first seek, which may be to any frame).
+    std::size_t frame() const { return shown_; }
+    // Plays on to frame n, from shown() up to frameCount(). A cancelled seek (Cancelled,
+    // from the sculptor's interrupter) leaves the grid half-made: drop the player and grid.
+    void seek(std::size_t n);
+
+  private:
+    void takeBackPartial();
+    // Applies the deformation the play head is at, whole, and moves on to the next.
+    void finishPart();
+
+    Sculptor& sculptor_;
+    StrokeScript script_;
+    std::vector<double> durations_;
+    double fps_ = 24.0, seconds_ = 0.0;
+    std::size_t count_ = 1, shown_ = 0;
+    // The play head: stroke i_, its deformations parts_ (planned when it is reached; empty
+    // for a keyed stroke), the next one k_, and the time the next one starts.
+    std::size_t i_ = 0, k_ = 0;
+    bool planned_ = false, partialOn_ = false;
+    std::vector<std::unique_ptr<StepDeformation>> parts_;
+    double start_ = 0.0;
+};
+
 // Plays the script's strokes on the sculptor's grid and calls show(frame, time, grid) for
 // each frame from `first` to `last` (at most the film's count) for which wanted(frame)
-// holds (none: every one); a frame not wanted costs no partial deformation. Returns once
-// `last` is shown, leaving the sculptor with every deformation that ended by then applied.
-// `progress` counts the frames from first to last.
+// holds (none: every one), through a FilmPlayer; a frame not wanted costs no partial
+// deformation. The grid is left as the last frame shown showed it. `progress` counts the
+// frames from first to last.
 void playFilm(Sculptor& sculptor, const StrokeScript& script, const FilmTiming& timing,
               std::size_t first, std::size_t last,
               const std::function<void(std::size_t, double, const Grid&)>& show,

@@ -26,7 +26,8 @@ grep -q "^Name: surface" "$tmp/print" && grep -q "^Name: density" "$tmp/print" &
   grep -q "class: level set" "$tmp/print" && grep -q "class: fog volume" "$tmp/print" &&
   grep -q "frame: 7" "$tmp/print" || fail "vdb_print: $(cat "$tmp/print")"
 
-# Every frame: names, classes, metadata (time = (frame - 1) / fps, one script digest), the
+# Every frame: names, classes, metadata (time = (frame - 1) / fps, a digest of what the
+# frame is made of: one per frame, as each shows the horn at another time), the
 # volume growing with the horn, and a fog volume: 0 outside, 1 deep inside, in between
 # only across the inside of the band.
 "$py" - "$tmp/f" <<'PY'
@@ -59,7 +60,7 @@ for n, path in enumerate(files, start=1):
             phi, rho = acc.getValue(ijk), fog.getValue(ijk)
             expected = 0.0 if phi >= 0 else min(1.0, -phi / band)
             assert abs(rho - expected) < 1e-5, (ijk, phi, rho)
-assert len(digests) == 1, digests
+assert len(digests) == len(files), digests
 # The voxels inside: the horn is pulled out frame after frame, none a still.
 assert all(b > a for a, b in zip(volumes, volumes[1:])), volumes
 print(f"{len(files)} frames read back: level set and fog volume, frame, time, fps, script")
@@ -83,6 +84,31 @@ volume() { "$cli" info --json "$1" | "$py" -c 'import json, sys; print(json.load
   --voxel-size $h -q
 [ "$(ls "$tmp/s" | wc -l)" = 5 ] || fail "the 2-second slide at 2 fps: $(ls "$tmp/s")"
 echo "keyed strokes: the grab comes back to the start, the bulge slides in 5 frames"
+
+# --- an edited key: refused without --force; with it, only the frames the key's spline
+# reaches are made again (key 1, at 0.5 s, shapes the spline from 0 to 1.5 s: frames 2 to 6
+# at 4 fps); the others are kept, untouched ------------------------------------------------
+sed 's/{ "time": 0.5, "t": \[1.3, 0.3, 0\] }/{ "time": 0.5, "t": [1.3, 0.45, 0] }/' \
+  "$data/animation/keyframed_grab.json" >"$tmp/edited_grab.json"
+! cmp -s "$tmp/edited_grab.json" "$data/animation/keyframed_grab.json" || fail "the key was not edited"
+cp -a "$tmp/g" "$tmp/g_before"
+grab_stamps() { for n in $(seq 9); do stat -c "$n %Y.%y" "$tmp/g/grab_$n.vdb"; done; }
+before=$(grab_stamps)
+refuses "sweepers-cli: $tmp/g/grab_2.vdb: not frame 2 of this film (another script, timing or voxel size); --force overwrites it" \
+  animate "$tmp/edited_grab.json" -o "$tmp/g/grab_#.vdb" --fps 4 --voxel-size $h
+"$cli" animate "$tmp/edited_grab.json" -o "$tmp/g/grab_#.vdb" --fps 4 --voxel-size $h \
+  --force 2>"$tmp/err"
+grep -q "wrote frames 1-9 of 9 (2 s at 4 fps) to $tmp/g/grab_#.vdb, 4 kept from before" \
+  "$tmp/err" || fail "edited key: $(cat "$tmp/err")"
+after=$(grab_stamps)
+rewritten=$({ diff <(echo "$before") <(echo "$after") || true; } | grep '^>' | cut -d' ' -f2 |
+  tr '\n' ' ')
+[ "$rewritten" = "2 3 4 5 6 " ] || fail "edited key 1: frames rewritten: $rewritten"
+for n in 3 4 6; do
+  if "$py" "$here/../app/same_grid.py" "$tmp/g/grab_$n.vdb" "$tmp/g_before/grab_$n.vdb" \
+    >/dev/null 2>&1; then fail "frame $n did not change with its key"; fi
+done
+echo "edited key 1: frames $rewritten made again, frames 1 and 7-9 kept"
 
 # --- resuming: the frames of the same film are kept, a missing one is made again -----------
 stamps() { stat -c '%n %Y.%y' "$tmp/f"/*.vdb | grep -v horn_0004; }

@@ -1,7 +1,10 @@
-// The modeler's window-free parts: the orbit camera and the input replay files.
+// The modeler's window-free parts: the orbit camera, the input replay files and the
+// timeline.
 #include <cstdio>
 #include <fstream>
 
+#define GLFW_INCLUDE_NONE // key codes only
+#include <GLFW/glfw3.h>
 #include <gtest/gtest.h>
 
 #include "app/camera.h"
@@ -48,9 +51,13 @@ TEST(InputReplay, ReadsEventsAndRefusesBadOnesWithTheirPlace) {
         {"frame": 1, "type": "press", "button": "right", "x": 10, "y": 20},
         {"frame": 1, "type": "move", "x": 11, "y": 21},
         {"frame": 3, "type": "key", "key": "z", "ctrl": true, "shift": true},
-        {"frame": 4, "type": "drop", "path": "a.vdb"}]})";
+        {"frame": 4, "type": "drop", "path": "a.vdb"},
+        {"frame": 5, "type": "key", "key": "."},
+        {"frame": 5, "type": "key", "key": "home"}]})";
     const auto ev = readInputEvents(path);
-    ASSERT_EQ(ev.size(), 4u);
+    ASSERT_EQ(ev.size(), 6u);
+    EXPECT_EQ(ev[4].key, GLFW_KEY_PERIOD);
+    EXPECT_EQ(ev[5].key, GLFW_KEY_HOME);
     EXPECT_EQ(ev[0].button, 1);
     EXPECT_EQ(ev[2].key, 'Z');
     EXPECT_TRUE(ev[2].ctrl && ev[2].shift);
@@ -66,5 +73,8 @@ TEST(InputReplay, ReadsEventsAndRefusesBadOnesWithTheirPlace) {
                   .find("/events/1: frames must not go back"),
               std::string::npos);
     EXPECT_NE(refused(R"({"events": [{"frame": 1, "type": "move", "x": 1}]})").find("/events/0"),
+              std::string::npos);
+    EXPECT_NE(refused(R"({"events": [{"frame": 1, "type": "key", "key": "hyper"}]})")
+                  .find("/events/0: key must be one character or one of space"),
               std::string::npos);
 }

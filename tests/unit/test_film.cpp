@@ -9,6 +9,7 @@
 
 #include "deform/step_prefix.h"
 #include "grids.h"
+#include "io/film_files.h"
 #include "io/stroke_script.h"
 #include "levelset/measure.h"
 #include "sculpt/film.h"
@@ -110,6 +111,27 @@ TEST(Film, AFrameIsTheSameWhicheverFramesAreWritten) {
     EXPECT_EQ(test::differingVoxels(*range.at(5), *all.at(5)), 0u);
     EXPECT_EQ(test::differingVoxels(*range.at(6), *all.at(6)), 0u);
     EXPECT_GT(test::differingVoxels(*all.at(5), *all.at(6)), 0u);
+}
+
+TEST(Film, APlayerSeeksOnFromAnyFrame) {
+    // A timeline's play head: frame after frame, or jumping on, each frame is the whole
+    // film's, the partial segment of one frame taken back before the next.
+    const StrokeScript s = script();
+    FilmTiming timing;
+    timing.fps = 12.0;
+    const auto all = play(s, timing);
+    Sculptor sculptor = startOf(s);
+    FilmPlayer player(sculptor, s, timing);
+    EXPECT_EQ(player.frameCount(), 10u);
+    EXPECT_EQ(player.frame(), 0u);
+    for (std::size_t n : {2, 3, 5, 9, 10}) {
+        player.seek(n);
+        EXPECT_EQ(player.frame(), n);
+        EXPECT_EQ(test::differingVoxels(sculptor.grid(), *all.at(n)), 0u) << "frame " << n;
+    }
+    EXPECT_THROW(player.seek(4), std::invalid_argument);  // back: a new player
+    EXPECT_THROW(player.seek(11), std::invalid_argument); // past the end
+    EXPECT_EQ(test::differingVoxels(sculptor.grid(), *all.at(10)), 0u);
 }
 
 TEST(Film, APrefixIsTheFirstSubSteps) {
@@ -351,4 +373,21 @@ TEST(Film, AnEditedKeyChangesOnlyTheFramesItShapes) {
         EXPECT_GT(test::differingVoxels(*before.at(n), *after.at(n)), 0u) << "frame " << n;
     for (std::size_t n : {1, 5, 7, 8, 9, 10, 11})
         EXPECT_EQ(test::differingVoxels(*before.at(n), *after.at(n)), 0u) << "frame " << n;
+    // What the frames are made of, as `animate` stamps them: key 1 reaches frames 2 to 6
+    // (0.1 to 0.5 s: the spline pieces from key 0 to key 3), so every frame that changed
+    // has another digest, and the frames from key 3 on keep theirs.
+    const auto was = frameDigests(text, parseStrokeScript(text, "six.json"), timing);
+    const auto is = frameDigests(edited, parseStrokeScript(edited, "edited.json"), timing);
+    ASSERT_EQ(was.size(), 12u);
+    ASSERT_EQ(is.size(), 12u);
+    for (std::size_t n = 1; n <= 11; ++n) {
+        const bool reached = n >= 2 && n <= 6;
+        EXPECT_EQ(was[n] != is[n], reached) << "frame " << n;
+        if (test::differingVoxels(*before.at(n), *after.at(n)) > 0) {
+            EXPECT_NE(was[n], is[n]) << "frame " << n;
+        }
+    }
+    // Another fog grid in the files, another digest.
+    EXPECT_NE(frameDigests(text, parseStrokeScript(text, "six.json"), timing, "density")[7],
+              was[7]);
 }
