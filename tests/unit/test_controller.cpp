@@ -34,10 +34,11 @@ class StopAfter : public Interrupter {
     std::atomic<int> left_;
 };
 
-struct Session {
+// A document on a sculpt controller, looked at whole (not the crash-safety Session).
+struct Bench {
     Document doc{Document::sphereScript(1.0 / 32), "."};
     SculptController ctl{/*waitEachPiece=*/true};
-    Session() {
+    Bench() {
         ctl.setViewport(kWidth, kHeight);
         ctl.setDocument(&doc);
         ctl.frameView();
@@ -94,10 +95,10 @@ TEST(SculptController, AFastTwistTurnsTheWayTheHandWent) {
     // 2000 pixels right in one move (the angle saturates at 720 degrees) against the same
     // drag in 20-pixel moves, and 400 pixels (200 degrees) both ways.
     for (const double pixels : {400.0, 2000.0}) {
-        Session slow, flick;
+        Bench slow, flick;
         slow.twist(pixels, 20);
         flick.twist(pixels, pixels);
-        for (const Session* s : {&slow, &flick}) {
+        for (const Bench* s : {&slow, &flick}) {
             const auto& path = s->tool().path;
             for (std::size_t i = 1; i < path.size(); ++i)
                 ASSERT_LT(std::abs(path[i].angleDegrees - path[i - 1].angleDegrees),
@@ -148,7 +149,7 @@ TEST(SculptController, EveryReplayFileSculptsAndRecordsAScriptThatReplaysExactly
 }
 
 TEST(SculptController, EscapeCancelsTheDragAndPutsTheShapeBack) {
-    Session s;
+    Bench s;
     const GridPtr before = s.doc.grid().deepCopy();
     const double volume = s.doc.mesher().enclosedVolume();
     s.ctl.onKey('G', false, false);
@@ -220,7 +221,7 @@ TEST(SculptController, PinchModeGoesThroughTheShapeAlongTheView) {
     // P, a press on the middle of the sphere and a drag: the pinch's needles lie on the view
     // ray through the press, on either side of the sphere, the drag sets the hole's radius,
     // and the preview shows it all before the release applies it: a torus.
-    Session s;
+    Bench s;
     s.ctl.onKey('P', false, false);
     const double x0 = kWidth / 2.0, y0 = kHeight / 2.0;
     s.ctl.onButton(0, true, x0, y0, false);
@@ -266,7 +267,7 @@ TEST(SculptController, StrangleModeCutsAroundTheLimbUnderTheCursor) {
     // K, a press on the middle of the sphere and a drag across it, past its outline: the
     // circle lies in the plane of the drag and the view, around the sphere's centre, and the
     // release cuts the sphere in two. A release without a drag says what to do instead.
-    Session s;
+    Bench s;
     s.ctl.onKey('K', false, false);
     const double x0 = kWidth / 2.0, y0 = kHeight / 2.0;
     s.ctl.onButton(0, true, x0, y0, false);
@@ -309,7 +310,7 @@ TEST(SculptController, AToolFromAFileGrabsAndIsRecordedByItsFile) {
     sweepers::test::ScratchDir dir;
     writeLevelSet(*makeSphere(Eigen::Vector3d::Zero(), 1.0, 1.0 / 16, 3.0), dir / "tool.vdb");
     std::ofstream(dir / "broken.vdb") << "not a vdb";
-    Session s;
+    Bench s;
     try {
         s.ctl.useToolFile(dir / "broken.vdb");
         ADD_FAILURE() << "a broken file was taken as a tool";

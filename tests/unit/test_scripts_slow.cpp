@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 
+#include "coarse.h"
 #include "io/start_grid.h"
 #include "io/stroke_script.h"
 #include "levelset/band.h"
@@ -19,11 +20,9 @@
 
 using namespace sweepers;
 
-namespace {
+using sweepers::test::coarse;
 
-bool coarse() {
-    return std::getenv("SWEEPERS_COARSE_TESTS") != nullptr;
-}
+namespace {
 
 std::string dataPath(const std::string& name) {
     return std::string(SWEEPERS_DATA_DIR) + "/" + name + ".json";
@@ -40,9 +39,10 @@ Placement at(const Eigen::Vector3d& t) {
     return p;
 }
 
-class DataScript : public ::testing::TestWithParam<const char*> {};
-
 } // namespace
+
+// (Outside the anonymous namespace: the tests GoogleTest derives from it are not in it.)
+class DataScript : public ::testing::TestWithParam<const char*> {};
 
 // The share of interface voxels whose |grad phi| lies in [0.9, 1.1]. A pinch or a strangle
 // tears a hole whose rim is a crease of the exact shape (the image of the point where the

@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 #include <openvdb/tools/Interpolation.h>
 
+#include "coarse.h"
 #include "levelset/band.h"
 #include "levelset/create.h"
 #include "levelset/measure.h"
@@ -21,11 +22,9 @@
 
 using namespace sweepers;
 
-namespace {
+using sweepers::test::coarse;
 
-bool coarse() {
-    return std::getenv("SWEEPERS_COARSE_TESTS") != nullptr;
-}
+namespace {
 
 std::vector<double> pinchVoxelSizes() {
     if (coarse()) return {1.0 / 32};
