@@ -82,6 +82,13 @@ int runCheck(const std::string& path, bool asJson) {
                 SwirlSegment(toSwirl(*swirl)), 0.0);
         } else if (std::holds_alternative<InflateStroke>(stroke)) {
             out.push_back({{"stroke", i}, {"type", "inflate"}});
+        } else if (const auto* flow = std::get_if<FlowStroke>(&stroke)) {
+            // Without a segment count, the segments are chosen on the shape when applied.
+            const auto field = makeField(flow->field);
+            const auto parts = planFlow(field, flow->from, flow->to, std::max(1, flow->segments));
+            for (std::size_t k = 0; k < parts.size(); ++k)
+                row(i, "flow (" + fieldName(flow->field.kind) + ")", k, 0, *parts[k], 0.0);
+            if (flow->segments == 0) out.back()["segments"] = "chosen on the shape";
         } else if (keyedDuration(stroke) > 0.0) {
             // As `apply` takes it: at its last key.
             const bool keyframed = std::holds_alternative<KeyframedStroke>(stroke);
@@ -120,6 +127,13 @@ int runCheck(const std::string& path, bool asJson) {
         if (row["type"] == "keyframed at rest") {
             std::cout << "  stroke " << row["stroke"]
                       << ": keyframed, back at rest at its last key (apply leaves the shape)\n";
+            continue;
+        }
+        if (row.contains("segments")) {
+            std::cout << "  stroke " << row["stroke"] << ": " << row["type"].get<std::string>()
+                      << ", " << row["steps"] << " sub-steps, in as many segments as the "
+                      << "shape's stretch needs (chosen when applied), affected box "
+                      << row["affected_box"].dump() << "\n";
             continue;
         }
         if (row["type"] != "sweep") {

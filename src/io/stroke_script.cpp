@@ -12,6 +12,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/format.h"
 #include "io/atomic_file.h"
 #include "io/baked_tool.h"
 
@@ -331,6 +332,52 @@ InflateStroke readInflate(const Reader& r, const json& v, const std::string& at)
     return s;
 }
 
+FlowStroke readFlow(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"type", "field", "from", "to", "segments"});
+    FlowStroke s;
+    const json& f = r.require(v, at, "field");
+    const std::string fat = at + "/field";
+    if (f.is_string() && f.get<std::string>() == "enright") {
+        s.field.kind = FieldSpec::Kind::Enright;
+    } else if (f.is_string() && f.get<std::string>() == "vortex") {
+        s.field.kind = FieldSpec::Kind::Vortex;
+    } else if (f.is_object() && f.contains("rotation")) {
+        r.onlyKeys(f, fat, {"rotation"});
+        const json& rot = f["rotation"];
+        const std::string rat = fat + "/rotation";
+        r.onlyKeys(rot, rat, {"center", "axis", "degrees_per_second", "radius", "falloff"});
+        s.field.kind = FieldSpec::Kind::Rotation;
+        s.field.center = r.vec3(r.require(rot, rat, "center"), rat + "/center");
+        s.field.axis = r.vec3(r.require(rot, rat, "axis"), rat + "/axis");
+        if (!(s.field.axis.norm() > 0.0)) r.fail(rat + "/axis", "needs a direction (not zero)");
+        s.field.degreesPerSecond =
+            r.number(r.require(rot, rat, "degrees_per_second"), rat + "/degrees_per_second");
+        s.field.radius = r.positive(r.require(rot, rat, "radius"), rat + "/radius");
+        s.field.falloff = r.positive(r.require(rot, rat, "falloff"), rat + "/falloff");
+    } else {
+        r.fail(fat, "expected \"enright\", \"vortex\" or {\"rotation\": {...}}, got " +
+                        Reader::describe(f));
+    }
+    s.from = r.number(r.require(v, at, "from"), at + "/from");
+    s.to = r.number(r.require(v, at, "to"), at + "/to");
+    if (!(s.to > s.from))
+        r.fail(at + "/to", "a flow runs forward in time: to (" + formatNumber(s.to) +
+                               ") must come after from (" + formatNumber(s.from) + ")");
+    if (auto it = v.find("segments"); it != v.end()) {
+        if (!it->is_number_integer() || it->get<long long>() < 1 || it->get<long long>() > 4096)
+            r.fail(at + "/segments",
+                   "expected a whole number from 1 to 4096, got " + Reader::describe(*it));
+        s.segments = it->get<int>();
+    }
+    // Sub-steps last at most 1 / (2 L) (deform/flow.h): a span that needs more than a
+    // hundred thousand of them is refused before any work.
+    const double subSteps = 2.0 * makeField(s.field)->lipschitz() * (s.to - s.from);
+    if (subSteps > 1e5)
+        r.fail(at, "the flow would take " + formatNumber(std::ceil(subSteps)) +
+                       " sub-steps (more than 100000): shorten its time or slow its field");
+    return s;
+}
+
 // A pinch or a strangle: the same fields, checked by the tool's own rules.
 template <typename StrokeT, typename Check>
 StrokeT readTopologyTool(const Reader& r, const json& v, const std::string& at, Check check) {
@@ -564,10 +611,12 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
             s.strokes.emplace_back(readKeyframed(r, v, at));
         else if (type == "slide")
             s.strokes.emplace_back(readSlide(r, v, at));
+        else if (type == "flow")
+            s.strokes.emplace_back(readFlow(r, v, at));
         else
             r.fail(at + "/type", "unknown stroke type \"" + type +
                                      "\" (expected sweep, swirl, inflate, pinch, strangle, "
-                                     "keyframed or slide)");
+                                     "keyframed, slide or flow)");
         if (keyedDuration(s.strokes.back()) > 0.0 && i < s.durations.size() && s.durations[i] > 0.0)
             r.fail(at + "/duration", "a " + type + " stroke lasts until its last key");
     }
@@ -675,6 +724,21 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             j["type"] = "keyframed";
             j["tool"] = toolJson(keyed->tool, false);
             j["keys"] = keysJson(keyed->keys);
+        } else if (const auto* flow = std::get_if<FlowStroke>(&stroke)) {
+            j["type"] = "flow";
+            const FieldSpec& f = flow->field;
+            if (f.kind == FieldSpec::Kind::Rotation)
+                j["field"] = {{"rotation",
+                               {{"center", vecJson(f.center)},
+                                {"axis", vecJson(f.axis)},
+                                {"degrees_per_second", f.degreesPerSecond},
+                                {"radius", f.radius},
+                                {"falloff", f.falloff}}}};
+            else
+                j["field"] = fieldName(f.kind);
+            j["from"] = flow->from;
+            j["to"] = flow->to;
+            if (flow->segments > 0) j["segments"] = flow->segments;
         } else {
             const SlideStroke& slide = std::get<SlideStroke>(stroke);
             j["type"] = "slide";

@@ -1,5 +1,7 @@
 #include "levelset/band.h"
 
+#include <algorithm>
+
 #include <openvdb/tools/Diagnostics.h>
 #include <openvdb/tree/LeafManager.h>
 #include <tbb/blocked_range.h>
@@ -70,6 +72,19 @@ BandReport checkBand(const Grid& grid) {
     r.unitGradient = c.unit;
     r.beyondBand = c.beyond;
     return r;
+}
+
+std::vector<Eigen::Vector3d> surfacePoints(const Grid& grid, std::size_t most) {
+    std::vector<openvdb::Coord> all;
+    const auto acc = grid.getConstAccessor();
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
+        for (auto it = leaf->cbeginValueOn(); it; ++it)
+            if (nextToCrossing(*leaf, it.pos(), acc)) all.push_back(it.getCoord());
+    const std::size_t stride = most == 0 ? all.size() + 1 : (all.size() + most - 1) / most;
+    std::vector<Eigen::Vector3d> points;
+    for (std::size_t i = 0; i < all.size(); i += std::max<std::size_t>(1, stride))
+        points.push_back(toEigen(grid.indexToWorld(all[i])));
+    return points;
 }
 
 Box activeWorldBox(const Grid& grid) {

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "core/box.h"
 #include "levelset/vdb.h"
@@ -30,5 +31,9 @@ BandReport checkBand(const Grid& grid);
 
 // World-space box of the active voxels.
 Box activeWorldBox(const Grid& grid);
+
+// The centres of the voxels next to the zero crossing, evenly thinned to at most `most` (a
+// sample of the surface, in leaf order; walks the whole grid).
+std::vector<Eigen::Vector3d> surfacePoints(const Grid& grid, std::size_t most);
 
 } // namespace sweepers

@@ -45,13 +45,15 @@ std::vector<double> strokeDurations(const StrokeScript& script, const FilmTiming
         throw std::invalid_argument("the seconds per segment must be positive");
     std::vector<double> seconds;
     for (std::size_t i = 0; i < script.strokes.size(); ++i) {
-        // A keyed stroke lasts until its last key.
-        const double keyed = keyedDuration(script.strokes[i]);
+        // A keyed stroke lasts until its last key, a flow its own time unless told.
+        const Stroke& stroke = script.strokes[i];
+        const double keyed = keyedDuration(stroke);
         const double given = i < script.durations.size() ? script.durations[i] : 0.0;
-        seconds.push_back(keyed > 0.0 ? keyed
-                          : given > 0.0
-                              ? given
-                              : timing.secondsPerSegment * double(pathSegments(script.strokes[i])));
+        const auto* flow = std::get_if<FlowStroke>(&stroke);
+        seconds.push_back(keyed > 0.0   ? keyed
+                          : given > 0.0 ? given
+                          : flow        ? flow->to - flow->from
+                                        : timing.secondsPerSegment * double(pathSegments(stroke)));
     }
     return seconds;
 }

@@ -91,6 +91,8 @@ std::size_t segmentCount(const Stroke& stroke, double voxelSize) {
         return planStrangle(*strangle, voxelSize).size();
     if (const auto* slide = std::get_if<SlideStroke>(&stroke))
         return toSweep(slide->local).segmentCount();
+    if (const auto* flow = std::get_if<FlowStroke>(&stroke))
+        return std::size_t(std::max(1, flow->segments));
     return 1;
 }
 
@@ -120,6 +122,13 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
             [&](const StrangleStroke& s) { parts = planStrangle(s, grid.voxelSize()[0]); },
             [&](const KeyframedStroke&) { parts = planKeyedStroke(stroke, keyedDuration(stroke)); },
             [&](const SlideStroke&) { parts = planKeyedStroke(stroke, keyedDuration(stroke)); },
+            [&](const FlowStroke& s) {
+                const auto field = makeField(s.field);
+                const int n = s.segments > 0
+                                  ? s.segments
+                                  : flowSegments(*field, s.from, s.to, surfacePoints(grid, 512));
+                parts = planFlow(field, s.from, s.to, n);
+            },
         },
         stroke);
     return parts;

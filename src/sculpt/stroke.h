@@ -11,6 +11,7 @@
 //             (3.5.2)
 //   keyframed - a tool whose target placement is keyed over time (3.6.1)
 //   slide   - a sweep in a local frame keyed over time (3.6.1)
+//   flow    - the shape carried by a velocity field over a span of time (chapter 4)
 #pragma once
 
 #include <cstddef>
@@ -21,6 +22,7 @@
 
 #include <Eigen/Core>
 
+#include "deform/flow.h"
 #include "deform/keyframes.h"
 #include "deform/pinch.h"
 #include "deform/placement.h"
@@ -111,8 +113,17 @@ struct SlideStroke {
     Keyframes frame;
 };
 
+// The shape carried by a velocity field (deform/flow.h) from time `from` to `to`, in
+// `segments` resamples; 0: the fewest the advection can follow (flowSegments, measured on the
+// surface as it is when the stroke comes).
+struct FlowStroke {
+    FieldSpec field;
+    double from = 0.0, to = 1.0;
+    int segments = 0;
+};
+
 using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke, PinchStroke, StrangleStroke,
-                            KeyframedStroke, SlideStroke>;
+                            KeyframedStroke, SlideStroke, FlowStroke>;
 
 struct StrokeScript {
     int version = 1;
@@ -139,7 +150,8 @@ double keyedDuration(const Stroke& stroke);
 std::vector<std::unique_ptr<StepDeformation>> planKeyedStroke(const Stroke& stroke, double time);
 
 // How many deformations planStroke makes of a stroke at the given voxel size (a sweep's
-// segments, a pinch's or a strangle's segments and its pull, else one).
+// segments, a pinch's or a strangle's segments and its pull, a flow's segments when it
+// gives them, else one).
 std::size_t segmentCount(const Stroke& stroke, double voxelSize);
 
 // The deformations of one stroke, in order: a sweep's segments, one swirl ring or

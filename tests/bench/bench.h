@@ -60,6 +60,7 @@ void registerScaleBenchmarks();
 void registerAdvectBenchmarks();
 void registerRenormalizeBenchmarks();
 void registerMeshBenchmarks();
+void registerEnrightBenchmarks();
 
 // The benchmark name is "group/case/method"; times are wall-clock milliseconds.
 benchmark::internal::Benchmark* add(const std::string& name,

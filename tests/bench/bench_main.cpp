@@ -187,7 +187,7 @@ Name split(const std::string& name) {
 
 // The OpenVDB tool each group is measured against.
 std::string referenceOf(const std::string& group) {
-    if (group == "advect") return "openvdb_LevelSetAdvection";
+    if (group == "advect" || group == "enright") return "openvdb_LevelSetAdvection";
     if (group == "renorm") return "openvdb_sdfToSdf";
     if (group == "mesh") return "openvdb_volumeToMesh";
     return "";
@@ -257,6 +257,7 @@ int main(int argc, char** argv) {
     registerAdvectBenchmarks();
     registerRenormalizeBenchmarks();
     registerMeshBenchmarks();
+    registerEnrightBenchmarks();
 
     Collector collector;
     benchmark::RunSpecifiedBenchmarks(&collector);

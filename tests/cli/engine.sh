@@ -196,4 +196,29 @@ assert faces(sys.argv[1]) == faces(sys.argv[2]), "the triangles changed"
 PY
 if "$cli" mesh "$tmp/sphere.vdb" -o "$tmp/x.obj" --up x 2>/dev/null; then fail "--up x accepted"; fi
 
+# --- a flow: Enright's sphere carried to t = 3 comes back; bad flows are refused -------
+"$cli" apply "$data/flows/enright.json" -o "$tmp/enright.vdb" --voxel-size 0.03125 2>"$tmp/log"
+grep -q "1 segments" "$tmp/log" || fail "Enright to t = 3: $(cat "$tmp/log")"
+"$cli" new -o "$tmp/enright_start.vdb" --voxel-size 0.03125 --radius 0.15 --center 0.35 0.35 0.35
+"$py" - "$tmp/enright_start.vdb" "$tmp/enright.vdb" <<'PY'
+import sys, pyopenvdb as vdb
+import numpy as np
+def inside(path):
+    g = vdb.read(path, "surface")
+    lo, hi = g.evalActiveVoxelBoundingBox()
+    a = np.empty([hi[k] - lo[k] + 1 for k in range(3)], dtype=np.float32)
+    g.copyToArray(a, ijk=lo)
+    return int((a < 0).sum())
+before, after = inside(sys.argv[1]), inside(sys.argv[2])
+print(f"Enright at 1/32 to t = 3: {before} voxels inside before, {after} after")
+assert abs(after - before) <= 0.02 * before, (before, after)
+PY
+sed 's/"from": 0, "to": 3/"from": 3, "to": 0/' "$data/flows/enright.json" >"$tmp/backwards.json"
+refuses "sweepers-cli: $tmp/backwards.json: /strokes/0/to: a flow runs forward in time: to (0) must come after from (3)" \
+  apply "$tmp/backwards.json" -o "$tmp/no.vdb"
+sed 's/"to": 3 }/"to": 3, "segments": 0 }/' "$data/flows/enright.json" >"$tmp/zero.json"
+refuses "sweepers-cli: $tmp/zero.json: /strokes/0/segments: expected a whole number from 1 to 4096, got 0" \
+  apply "$tmp/zero.json" -o "$tmp/no.vdb"
+[ ! -e "$tmp/no.vdb" ] || fail "a refused flow wrote its output"
+
 echo "engine cli: ok"
