@@ -2,16 +2,7 @@
 # The modeler's timeline in a real window (run under xvfb-run with Mesa): a replayed drag,
 # its history opened as a film (V) and stepped with the keys to its middle frame, which is
 # saved and measured; the film recorded as PNGs; a directory for them that cannot be made.
-set -euo pipefail
-app=$1
-cli=$2
-here=$(cd "$(dirname "$0")" && pwd)
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
-# No leak check for the windowed modeler under AddressSanitizer (see modeler.sh).
-app_asan=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0
+. "$(dirname "$0")/common.sh" "$@"
 run() { ASAN_OPTIONS=$app_asan "$app" --size 640x480 --hide-ui "$@"; }
 
 # --- the drag of drag_a.json (4 path segments: a film of 4 x 0.25 s at 24 fps, 25 frames),

@@ -2,19 +2,8 @@
 # The modeler in a real window (run under xvfb-run with Mesa): screenshots read back as
 # pixels, replayed mouse and keyboard input, undo / redo, the recorded script replayed by
 # sweepers-cli, and bad files opened in the window.
-set -euo pipefail
-app=$1
-cli=$2
+. "$(dirname "$0")/common.sh" "$@"
 headless=$3
-here=$(cd "$(dirname "$0")" && pwd)
-py=/usr/bin/python3
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-fail() { echo "FAIL: $*"; exit 1; }
-# Under AddressSanitizer, the windowed modeler runs without the leak check: Mesa unloads its
-# driver first, so the driver's allocations can be neither named nor suppressed. The sculpt
-# controller and the command line below keep theirs.
-app_asan=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0
 # New spheres at voxel size 1/32: the window, the input and the files are what is tested
 # here, and the engine at finer sizes elsewhere.
 run() { ASAN_OPTIONS=$app_asan "$app" --size 640x480 --voxel-size 0.03125 "$@"; }
