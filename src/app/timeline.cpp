@@ -59,7 +59,6 @@ bool Timeline::step(Clock::time_point now) {
         const std::size_t before = shown_;
         shown_ = player_ ? player_->frame() : 0;
         fresh = shown_ != 0 && (shown_ != before || rebuilt_);
-        if (!player_) shown_ = 0;
     }
     // A frame just made waits a step before the next is begun: the window shows it first.
     if (!fresh && !work_.valid() && wanted_ != shown_ && message_.empty()) {
