@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/checks.h"
 #include "deform/tear.h"
 
 namespace sweepers {
@@ -14,10 +15,6 @@ namespace {
 // A fixed-point iteration of the forward map that has not converged by then sits on a
 // needle's tip, where the map is discontinuous: its last iterate is as good as any.
 constexpr int kForwardIterations = 60;
-
-bool finitePositive(double v) {
-    return v > 0.0 && std::isfinite(v);
-}
 
 // The needles' segments: each moves the tips by at most a quarter of the falloff.
 std::size_t needleSegments(const PinchSpec& spec) {

@@ -5,6 +5,7 @@
 #include <limits>
 #include <stdexcept>
 
+#include "core/checks.h"
 #include "deform/tear.h"
 
 namespace sweepers {
@@ -13,10 +14,6 @@ namespace {
 
 constexpr int kForwardIterations = 60; // as for the needles: a non-converged point is on the circle
 constexpr double kNooseSegmentRatio = 2.0;
-
-bool finitePositive(double v) {
-    return v > 0.0 && std::isfinite(v);
-}
 
 ConeField nooseField(const StrangleSpec& spec) {
     return {kNooseInDegrees * kDegree, kNooseOutDegrees * kDegree, spec.size,

@@ -6,15 +6,10 @@
 
 #include <Eigen/Geometry>
 
+#include "core/checks.h"
 #include "core/falloff.h"
 
 namespace sweepers {
-
-namespace {
-bool finitePositive(double v) {
-    return v > 0.0 && std::isfinite(v);
-}
-} // namespace
 
 Tear::Tear(Set set, const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius, double open,
            double reach)

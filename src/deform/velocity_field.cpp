@@ -5,6 +5,8 @@
 
 #include <Eigen/Geometry>
 
+#include "core/checks.h"
+
 namespace sweepers {
 
 namespace {
@@ -95,7 +97,7 @@ std::shared_ptr<const VelocityField> makeField(const FieldSpec& spec) {
     if (!spec.center.allFinite() || !spec.axis.allFinite() || !std::isfinite(spec.degreesPerSecond))
         throw std::invalid_argument("a rotation field's center, axis and speed must be finite");
     if (!(spec.axis.norm() > 0.0)) throw std::invalid_argument("a rotation field needs an axis");
-    if (!(spec.radius > 0.0 && spec.falloff > 0.0) || !std::isfinite(spec.radius + spec.falloff))
+    if (!finitePositive(spec.radius) || !finitePositive(spec.falloff))
         throw std::invalid_argument("a rotation field's radius and falloff must be positive");
     return std::make_shared<Rotation>(spec);
 }

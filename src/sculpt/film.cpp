@@ -4,15 +4,12 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/checks.h"
 #include "deform/step_prefix.h"
 
 namespace sweepers {
 
 namespace {
-
-bool finitePositive(double v) {
-    return v > 0.0 && std::isfinite(v);
-}
 
 // Path segments of a sweep, one for any other stroke: what the sculptor sees as the
 // stroke's length, whatever the voxel size makes of a pinch or a strangle.
