@@ -17,7 +17,6 @@ FlowStep::FlowStep(std::shared_ptr<const VelocityField> field, double t0, double
     steps_ = std::max(1, int(std::ceil(2.0 * L * (t1 - t0))));
     dt_ = (t1 - t0) / steps_;
     affected_ = field_->support();
-    forwardTolerance_ = 1e-12;
 }
 
 Eigen::Vector3d FlowStep::trace(const Eigen::Vector3d& p, double a, double b, int steps) const {
@@ -78,6 +77,10 @@ int flowSegments(const VelocityField& field, double t0, double t1,
     const double h = span / steps;
     // J[c]: the Jacobian of the flow map from t0 to checkpoint c, for every point.
     std::vector<std::vector<Eigen::Matrix3d>> J(points.size());
+    // RK4 on a point and, beside it, the variational equation of its Jacobian.
+    auto rate = [&](const Eigen::Vector3d& y, const Eigen::Matrix3d& N, double at) {
+        return std::make_pair(field.at(y, at), Eigen::Matrix3d(field.jacobian(y, at) * N));
+    };
     for (std::size_t i = 0; i < points.size(); ++i) {
         Eigen::Vector3d x = points[i];
         Eigen::Matrix3d M = Eigen::Matrix3d::Identity();
@@ -85,11 +88,6 @@ int flowSegments(const VelocityField& field, double t0, double t1,
         for (int c = 0; c < kCheckpoints; ++c)
             for (int s = 0; s < steps; ++s) {
                 const double t = t0 + c * span + s * h;
-                // RK4 on x and, beside it, the variational equation of its Jacobian.
-                auto rate = [&](const Eigen::Vector3d& y, const Eigen::Matrix3d& N, double at) {
-                    return std::make_pair(field.at(y, at),
-                                          Eigen::Matrix3d(field.jacobian(y, at) * N));
-                };
                 const auto k1 = rate(x, M, t);
                 const auto k2 = rate(x + 0.5 * h * k1.first, M + 0.5 * h * k1.second, t + 0.5 * h);
                 const auto k3 = rate(x + 0.5 * h * k2.first, M + 0.5 * h * k2.second, t + 0.5 * h);

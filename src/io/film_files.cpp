@@ -32,15 +32,39 @@ std::string framePath(const std::string& pattern, std::size_t frame) {
     return pattern.substr(0, at) + digits + pattern.substr(end);
 }
 
-std::string scriptDigest(const std::string& text) {
-    std::uint64_t h = 14695981039346656037ull;
-    for (const unsigned char c : text) {
-        h ^= c;
-        h *= 1099511628211ull;
+namespace {
+
+// 64-bit FNV-1a, fed piece by piece: a digest of what came so far can be copied and fed on.
+class Fnv {
+  public:
+    void add(const std::string& text) {
+        for (const unsigned char c : text) {
+            h_ ^= c;
+            h_ *= 1099511628211ull;
+        }
     }
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-    return hex;
+    std::string hex() const {
+        char hex[17];
+        std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h_));
+        return hex;
+    }
+
+  private:
+    std::uint64_t h_ = 14695981039346656037ull;
+};
+
+std::string decimal(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return text;
+}
+
+} // namespace
+
+std::string scriptDigest(const std::string& text) {
+    Fnv f;
+    f.add(text);
+    return f.hex();
 }
 
 std::vector<std::string> frameDigests(const std::string& scriptText, const StrokeScript& script,
@@ -76,36 +100,42 @@ std::vector<std::string> frameDigests(const std::string& scriptText, const Strok
             which.push_back(k);
         return which;
     };
+    auto keyed = [&](std::size_t i) { return keyedDuration(script.strokes[i]) > 0.0; };
+    std::vector<double> ends;
+    ends.reserve(durations.size());
+    for (double d : durations)
+        ends.push_back((ends.empty() ? 0.0 : ends.back()) + d);
+    // The film adds up its strokes' times its own way: a frame within a hair of a stroke's
+    // end counts as in it, with every key that can reach there, and in the next.
+    auto atEnd = [&](double time, std::size_t i) {
+        return std::abs(time - ends[i]) <= 1e-9 * std::max(1.0, ends[i]);
+    };
+    // What every frame from here on is made of: the script's grid and start, `extra`, and
+    // the strokes finished before the frame (a keyed one by its first and last key). The
+    // frames come in time order, so the finished strokes are added once each.
+    Fnv finished;
+    finished.add(header.dump() + "\n" + extra + "\n");
+    std::size_t done = 0;
     std::vector<std::string> digests(count + 1);
-    char number[40];
     for (std::size_t n = 1; n <= count; ++n) {
         const double time = filmFrameTime(n, seconds, timing.fps);
-        std::snprintf(number, sizeof number, "%.17g", time);
-        std::string made = header.dump() + "\n" + extra + "\n" + number + "\n";
-        double start = 0.0;
-        for (std::size_t i = 0; i < strokes.size(); ++i) {
-            const double end = start + durations[i];
-            const bool keyed = keyedDuration(script.strokes[i]) > 0.0;
-            // The film adds up its strokes' times its own way: a frame within a hair of a
-            // stroke's end counts as in it, with every key that can reach there.
-            const bool atEnd = std::abs(time - end) <= 1e-9 * std::max(1.0, end);
-            std::snprintf(number, sizeof number, " for %.17g", durations[i]);
-            if (time < end || atEnd) {
-                const double u = std::min(time, end) - start;
-                made += (keyed ? withKeys(strokes[i], keysAt(strokes[i], u)) : strokes[i]).dump() +
-                        number;
-                std::snprintf(number, sizeof number, " at %.17g\n", u);
-                made += number;
-                if (time < end) break;
-            } else {
-                made +=
-                    (keyed ? withKeys(strokes[i], {0, strokes[i]["keys"].size() - 1}) : strokes[i])
-                        .dump() +
-                    number + "\n";
-            }
-            start = end;
+        for (; done < strokes.size() && time > ends[done] && !atEnd(time, done); ++done)
+            finished.add((keyed(done)
+                              ? withKeys(strokes[done], {0, strokes[done]["keys"].size() - 1})
+                              : strokes[done])
+                             .dump() +
+                         " for " + decimal(durations[done]) + "\n");
+        // The stroke the frame falls in, and the time in it.
+        Fnv made = finished;
+        for (std::size_t i = done; i < strokes.size(); ++i) {
+            const double start = i == 0 ? 0.0 : ends[i - 1];
+            const double u = std::min(time, ends[i]) - start;
+            made.add((keyed(i) ? withKeys(strokes[i], keysAt(strokes[i], u)) : strokes[i]).dump() +
+                     " for " + decimal(durations[i]) + " at " + decimal(u) + "\n");
+            if (time < ends[i]) break;
         }
-        digests[n] = scriptDigest(made);
+        made.add("frame at " + decimal(time));
+        digests[n] = made.hex();
     }
     return digests;
 }
