@@ -610,8 +610,8 @@ class Modeler {
         ImGui::BeginDisabled(sculpting);
         int m = int(s.mode);
         for (std::size_t k = 0; k < kModes.size(); ++k) {
-            // Three rows: the sweeps; swirl and clay; the topology tools.
-            if (k != 0 && k != 3 && k != 5) ImGui::SameLine();
+            // Three rows: the sweeps; swirl, fluid and clay; the topology tools.
+            if (k != 0 && k != 3 && k != 6) ImGui::SameLine();
             ImGui::RadioButton(kModes[k].label, &m, int(kModes[k].mode));
         }
         s.mode = SculptMode(m);

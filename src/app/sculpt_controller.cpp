@@ -9,6 +9,7 @@
 #include <GLFW/glfw3.h>
 
 #include "io/baked_tool.h"
+#include "io/fluid_cache.h"
 #include "io/mesh_file.h"
 #include "levelset/band.h"
 #include "levelset/raycast.h"
@@ -80,7 +81,8 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
         beginTopologyDrag();
         return;
     }
-    if (settings_.mode == SculptMode::Swirl || settings_.mode == SculptMode::Clay) {
+    if (settings_.mode == SculptMode::Swirl || settings_.mode == SculptMode::Fluid ||
+        settings_.mode == SculptMode::Clay) {
         doc_->beginEdit();
         if (settings_.mode == SculptMode::Clay) {
             pendingSince_ = Clock::now();
@@ -354,6 +356,7 @@ Placement SculptController::placementAt(double x, double y) const {
     switch (settings_.mode) {
     case SculptMode::Grab:
     case SculptMode::Swirl:
+    case SculptMode::Fluid:
     case SculptMode::Clay:
     case SculptMode::Pinch:
     case SculptMode::Strangle:
@@ -421,7 +424,7 @@ void SculptController::finishDrag() {
 }
 
 // One piece of sculpting for the latest cursor position of a drag: a sweep segment (or a
-// few, for a fast twist), a swirl ring or a dab of clay.
+// few, for a fast twist), a swirl ring, a fluid push or a dab of clay.
 void SculptController::step() {
     collect();
     if (busy() || drag_ != DragKind::Sculpt) return;
@@ -451,6 +454,17 @@ void SculptController::step() {
                 sw.move = p.t - last_.t;
                 sw.radius = settings_.radius;
                 launch([doc, sw] { return doc->applyStroke(sw); });
+            } else if (settings_.mode == SculptMode::Fluid) {
+                // The ball pushes the clay as through a fluid from the last position to this
+                // one. The first fluid piece of a run finds the solution (from the cache, or
+                // a solve of a few seconds) on the worker, not in the window's thread.
+                FluidStroke fl;
+                fl.radius = settings_.radius;
+                fl.path = {last_.t, p.t};
+                launch([doc, fl]() mutable {
+                    fl.fluid = sweptFluid();
+                    return doc->applyStroke(fl);
+                });
             } else {
                 const std::vector<Placement> path = placementsTo(p);
                 launch([doc, path] {

@@ -26,10 +26,11 @@
 namespace sweepers {
 
 // Grab, twist and inflate are sweeps (one segment per piece); swirl moves clay while
-// keeping its volume (one swirl ring per piece, 4.1); clay adds material (Decaudin's
+// keeping its volume (one swirl ring per piece, 4.1), and so does fluid (the swept fluid of
+// 4.2, one fluid stroke per piece); clay adds material (Decaudin's
 // inflation, 2.30) under the cursor. Pinch and strangle change the topology (3.5): a drag
 // sets them up, shown as a preview, and the release applies the whole stroke.
-enum class SculptMode { Grab, Twist, Inflate, Swirl, Clay, Pinch, Strangle };
+enum class SculptMode { Grab, Twist, Inflate, Swirl, Fluid, Clay, Pinch, Strangle };
 
 // Each mode's key and its name in the panel, in SculptMode's order: the key handler and the
 // panel both read this table.
@@ -38,11 +39,12 @@ struct ModeInfo {
     int key;
     const char* label;
 };
-inline constexpr std::array<ModeInfo, 7> kModes{{
+inline constexpr std::array<ModeInfo, 8> kModes{{
     {SculptMode::Grab, 'G', "Grab (G)"},
     {SculptMode::Twist, 'T', "Twist (T)"},
     {SculptMode::Inflate, 'I', "Inflate (I)"},
     {SculptMode::Swirl, 'S', "Swirl, keeps volume (S)"},
+    {SculptMode::Fluid, 'U', "Fluid, keeps volume (U)"},
     {SculptMode::Clay, 'C', "Add clay (C)"},
     {SculptMode::Pinch, 'P', "Pinch a hole (P)"},
     {SculptMode::Strangle, 'K', "Strangle (K)"},

@@ -89,6 +89,16 @@ int runCheck(const std::string& path, bool asJson) {
             for (std::size_t k = 0; k < parts.size(); ++k)
                 row(i, "flow (" + fieldName(flow->field.kind) + ")", k, 0, *parts[k], 0.0);
             if (flow->segments == 0) out.back()["segments"] = "chosen on the shape";
+        } else if (const auto* fluid = std::get_if<FluidStroke>(&stroke)) {
+            // Each segment chains the flow steps of 4.26 (their count in "fluid_steps").
+            for (std::size_t k = 0; k + 1 < fluid->path.size(); ++k) {
+                row(i, "fluid", k, 1,
+                    *sweptFluidSegment(*fluid->fluid, fluid->radius, fluid->path[k],
+                                       fluid->path[k + 1]),
+                    0.0);
+                out.back()["fluid_steps"] = sweptFluidSteps(*fluid->fluid, fluid->radius,
+                                                            fluid->path[k], fluid->path[k + 1]);
+            }
         } else if (keyedDuration(stroke) > 0.0) {
             // As `apply` takes it: at its last key.
             const bool keyframed = std::holds_alternative<KeyframedStroke>(stroke);

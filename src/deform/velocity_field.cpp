@@ -91,6 +91,10 @@ std::shared_ptr<const VelocityField> makeField(const FieldSpec& spec) {
         return std::make_shared<Enright>();
     case FieldSpec::Kind::Vortex:
         return std::make_shared<Vortex>();
+    case FieldSpec::Kind::Sampled:
+        if (!spec.sampled)
+            throw std::invalid_argument("the velocity file " + spec.file + " was not read");
+        return spec.sampled;
     case FieldSpec::Kind::Rotation:
         break;
     }
@@ -110,6 +114,8 @@ std::string fieldName(FieldSpec::Kind kind) {
         return "vortex";
     case FieldSpec::Kind::Rotation:
         return "rotation";
+    case FieldSpec::Kind::Sampled:
+        return "vdb";
     }
     return "";
 }

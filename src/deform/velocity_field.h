@@ -25,13 +25,17 @@ class VelocityField {
 
 // What a script names (the "field" of a flow stroke).
 struct FieldSpec {
-    enum class Kind { Enright, Vortex, Rotation };
+    enum class Kind { Enright, Vortex, Rotation, Sampled };
     Kind kind = Kind::Enright;
     // Rotation: about the axis through `center`, `degreesPerSecond` (right-handed), rigid
     // within `radius` of the center and easing to rest over `falloff` beyond it (C1).
     Eigen::Vector3d center = Eigen::Vector3d::Zero();
     Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
     double degreesPerSecond = 90.0, radius = 1.0, falloff = 0.5;
+    // Sampled: a velocity grid in a VDB file (as written in the script, relative to it; the
+    // grid's name, empty for the first), read by io/ when the script is (sampled_field.h).
+    std::string file, gridName;
+    std::shared_ptr<const VelocityField> sampled;
 };
 
 // Enright et al.'s 3D deformation test (2002, after LeVeque): in the unit box,
@@ -43,11 +47,11 @@ struct FieldSpec {
 // Vortex: LeVeque's single vortex in the unit square, the same in every slice of the unit
 // box along z (w = 0), period T = 8:
 //   u = -sin^2(pi x) sin(2 pi y) cos(pi t / T),  v = sin^2(pi y) sin(2 pi x) cos(pi t / T).
-// Throws std::invalid_argument for a rotation that is not finite, or whose axis, radius or
-// falloff is not positive.
+// Sampled: the field io/ read. Throws std::invalid_argument for a rotation that is not
+// finite, or whose axis, radius or falloff is not positive, or a sampled field not read.
 std::shared_ptr<const VelocityField> makeField(const FieldSpec& spec);
 
-// The name a script gives the field ("enright", "vortex", "rotation").
+// The name a script gives the field ("enright", "vortex", "rotation", "vdb").
 std::string fieldName(FieldSpec::Kind kind);
 
 } // namespace sweepers

@@ -30,7 +30,7 @@ namespace sweepers {
 
 namespace {
 
-constexpr const char* kMarker = "--sweepers-read-level-set-for-parent";
+constexpr const char* kMarker = "--sweepers-read-grid-for-parent";
 // AddressSanitizer reserves terabytes of address space, so the child's memory limit cannot
 // be a limit on its address space there (GCC says so with __SANITIZE_ADDRESS__, clang with
 // __has_feature): the sanitizer's own limit on the resident memory stands in for it.
@@ -67,19 +67,30 @@ bool serveReadIfAsked() {
     std::vector<std::string> args;
     for (std::string arg; std::getline(cmdline, arg, '\0');)
         args.push_back(arg);
-    if (args.size() != 4 || args[1] != kMarker) return false;
+    if (args.size() != 5 || args[1] != kMarker) return false;
     // One thread: its memory limit holds the reader's work, not a stack and a malloc arena
     // for each of the machine's cores (64 MB of address space each).
     const tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
     try {
-        const LevelSetFile file = readLevelSetInProcess(args[2], args[3]);
+        openvdb::GridBase::ConstPtr grid;
+        std::string about; // what else the file holds: fields ended by NULs (a grid's name
+                           // may hold any other character)
+        std::vector<std::string> grids;
+        if (args[2] == "velocity") {
+            const VelocityFile file = readVelocityInProcess(args[3], args[4]);
+            grid = file.grid;
+            about = file.name + '\0' + "0" + '\0';
+            grids = file.grids;
+        } else {
+            const LevelSetFile file = readLevelSetInProcess(args[3], args[4]);
+            grid = file.grid;
+            about = file.name + '\0' + std::to_string(file.levelSets) + '\0';
+            grids = file.grids;
+        }
         std::ostringstream out;
-        openvdb::io::Stream(out).write(openvdb::GridCPtrVec{file.grid});
+        openvdb::io::Stream(out).write(openvdb::GridCPtrVec{grid});
         writeAll(kGridFd, out.str());
-        // What else the file holds, on the message pipe: fields ended by NULs (a grid's name
-        // may hold any other character).
-        std::string about = file.name + '\0' + std::to_string(file.levelSets) + '\0';
-        for (const std::string& g : file.grids)
+        for (const std::string& g : grids)
             about += g + '\0';
         writeAll(kMessageFd, about);
         ::_exit(0);
@@ -116,8 +127,20 @@ std::string selfPath() {
 
 } // namespace
 
-LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gridName,
-                                 const ReadLimits& limits) {
+namespace {
+
+// What the child sent: its grid, its name in the file, how many level sets the file holds and
+// what grids.
+struct ChildRead {
+    openvdb::GridBase::Ptr grid;
+    std::string name;
+    std::size_t levelSets = 0;
+    std::vector<std::string> grids;
+};
+
+// Runs the child reader of `kind` ("level-set" or "velocity") on the file.
+ChildRead readInChild(const char* kind, const std::string& path, const std::string& gridName,
+                      const ReadLimits& limits) {
     (void)gServed;
     initVdb();
     const std::string self = selfPath();
@@ -129,7 +152,8 @@ LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gri
         throw FileError("cannot start the file reader (pipe)");
     }
     const double bytes = limits.bytes > 0 ? limits.bytes : readerMemory(path);
-    std::vector<const char*> argv{self.c_str(), kMarker, path.c_str(), gridName.c_str(), nullptr};
+    std::vector<const char*> argv{self.c_str(), kMarker,          kind,
+                                  path.c_str(), gridName.c_str(), nullptr};
     // The child's environment: the parent's, and under AddressSanitizer a resident-memory
     // limit in its options (without one, a damaged file that makes the reader allocate
     // gigabytes took 30 s there, where the address-space limit stops it in 3).
@@ -146,6 +170,7 @@ LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gri
                       "hard_rss_limit_mb=" + std::to_string(std::size_t(bytes / (1 << 20))));
     }
     std::vector<char*> envp;
+    envp.reserve(env.size() + 1);
     for (std::string& e : env)
         envp.push_back(e.data());
     envp.push_back(nullptr);
@@ -229,22 +254,46 @@ LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gri
         std::istringstream in(grid);
         openvdb::io::Stream stream(in, /*delayLoad=*/false);
         const openvdb::GridPtrVecPtr grids = stream.getGrids();
-        GridPtr g = grids && !grids->empty() ? openvdb::gridPtrCast<Grid>(grids->front()) : nullptr;
         std::vector<std::string> fields;
         for (std::size_t at = 0, end; (end = message.find('\0', at)) != std::string::npos;
              at = end + 1)
             fields.push_back(message.substr(at, end - at));
-        if (g && fields.size() >= 2) {
-            LevelSetFile file;
-            file.grid = g;
-            file.name = fields[0];
-            file.levelSets = std::stoul(fields[1]);
-            file.grids.assign(fields.begin() + 2, fields.end());
-            return file;
+        if (grids && !grids->empty() && fields.size() >= 2) {
+            ChildRead read;
+            read.grid = grids->front();
+            read.name = fields[0];
+            read.levelSets = std::stoul(fields[1]);
+            read.grids.assign(fields.begin() + 2, fields.end());
+            return read;
         }
     } catch (const std::exception& e) {
     }
     throw FileError(path + ": the file reader returned no grid");
+}
+
+} // namespace
+
+LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gridName,
+                                 const ReadLimits& limits) {
+    ChildRead read = readInChild("level-set", path, gridName, limits);
+    LevelSetFile file;
+    file.grid = openvdb::gridPtrCast<Grid>(read.grid);
+    if (!file.grid) throw FileError(path + ": the file reader returned no level set");
+    file.name = std::move(read.name);
+    file.levelSets = read.levelSets;
+    file.grids = std::move(read.grids);
+    return file;
+}
+
+VelocityFile readVelocityInChild(const std::string& path, const std::string& gridName,
+                                 const ReadLimits& limits) {
+    ChildRead read = readInChild("velocity", path, gridName, limits);
+    VelocityFile file;
+    file.grid = openvdb::gridPtrCast<openvdb::Vec3SGrid>(read.grid);
+    if (!file.grid) throw FileError(path + ": the file reader returned no velocity grid");
+    file.name = std::move(read.name);
+    file.grids = std::move(read.grids);
+    return file;
 }
 
 } // namespace sweepers

@@ -1,4 +1,4 @@
-// Reading level-set files we did not write in a child process. OpenVDB's reader can
+// Reading level-set and velocity files we did not write in a child process. OpenVDB's reader can
 // crash, loop or allocate without bound on a damaged file; in a child with a time and a
 // memory limit the worst it can do is end that child, and the caller gets a FileError in
 // one line while its own work (a modeler session) goes on.
@@ -13,6 +13,7 @@
 #include <string>
 
 #include "io/vdb_file.h"
+#include "io/velocity_file.h"
 
 namespace sweepers {
 
@@ -26,6 +27,9 @@ struct ReadLimits {
 // the child's own message when it refuses the file, or saying that the file is damaged
 // when the child crashed, ran out of time or of memory.
 LevelSetFile readLevelSetInChild(const std::string& path, const std::string& gridName = "",
+                                 const ReadLimits& limits = {});
+// readVelocityInProcess(path, gridName) (io/velocity_file.h) in a child process, the same way.
+VelocityFile readVelocityInChild(const std::string& path, const std::string& gridName = "",
                                  const ReadLimits& limits = {});
 
 } // namespace sweepers

@@ -15,6 +15,8 @@
 #include "core/format.h"
 #include "io/atomic_file.h"
 #include "io/baked_tool.h"
+#include "io/fluid_cache.h"
+#include "io/velocity_file.h"
 
 namespace sweepers {
 
@@ -294,6 +296,27 @@ SlideStroke readSlide(const Reader& r, const json& v, const std::string& at) {
     return s;
 }
 
+FluidStroke readFluid(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, {"type", "radius", "path"});
+    FluidStroke s;
+    s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
+    const json& path = r.require(v, at, "path");
+    if (!path.is_array() || path.size() < 2)
+        r.fail(at + "/path", "expected two points or more, got " + Reader::describe(path));
+    for (std::size_t i = 0; i < path.size(); ++i) {
+        s.path.push_back(r.vec3(path[i], at + "/path/" + std::to_string(i)));
+        if (i > 0 && s.path[i] == s.path[i - 1])
+            r.fail(at + "/path/" + std::to_string(i),
+                   "the tool does not move from the point before");
+    }
+    try {
+        s.fluid = sweptFluid();
+    } catch (const std::exception& e) {
+        r.fail(at, std::string("cannot solve the swept fluid: ") + e.what());
+    }
+    return s;
+}
+
 SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, {"type", "at", "move", "radius", "ring", "swirls", "ball"});
     SwirlStroke s;
@@ -354,8 +377,20 @@ FlowStroke readFlow(const Reader& r, const json& v, const std::string& at) {
             r.number(r.require(rot, rat, "degrees_per_second"), rat + "/degrees_per_second");
         s.field.radius = r.positive(r.require(rot, rat, "radius"), rat + "/radius");
         s.field.falloff = r.positive(r.require(rot, rat, "falloff"), rat + "/falloff");
+    } else if (f.is_object() && f.contains("vdb")) {
+        r.onlyKeys(f, fat, {"vdb", "grid"});
+        s.field.kind = FieldSpec::Kind::Sampled;
+        s.field.file = r.string(f["vdb"], fat + "/vdb");
+        if (f.contains("grid")) s.field.gridName = r.string(f["grid"], fat + "/grid");
+        try {
+            s.field.sampled = std::make_shared<SampledField>(
+                readVelocitySamples(resolveAgainst(s.field.file, r.baseDir()), s.field.gridName));
+        } catch (const std::exception& e) {
+            r.fail(fat + "/vdb", e.what());
+        }
     } else {
-        r.fail(fat, "expected \"enright\", \"vortex\" or {\"rotation\": {...}}, got " +
+        r.fail(fat, "expected \"enright\", \"vortex\", {\"rotation\": {...}} or {\"vdb\": file}, "
+                    "got " +
                         Reader::describe(f));
     }
     s.from = r.number(r.require(v, at, "from"), at + "/from");
@@ -613,10 +648,12 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
             s.strokes.emplace_back(readSlide(r, v, at));
         else if (type == "flow")
             s.strokes.emplace_back(readFlow(r, v, at));
+        else if (type == "fluid")
+            s.strokes.emplace_back(readFluid(r, v, at));
         else
             r.fail(at + "/type", "unknown stroke type \"" + type +
                                      "\" (expected sweep, swirl, inflate, pinch, strangle, "
-                                     "keyframed, slide or flow)");
+                                     "keyframed, slide, flow or fluid)");
         if (keyedDuration(s.strokes.back()) > 0.0 && i < s.durations.size() && s.durations[i] > 0.0)
             r.fail(at + "/duration", "a " + type + " stroke lasts until its last key");
     }
@@ -724,6 +761,12 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             j["type"] = "keyframed";
             j["tool"] = toolJson(keyed->tool, false);
             j["keys"] = keysJson(keyed->keys);
+        } else if (const auto* fluid = std::get_if<FluidStroke>(&stroke)) {
+            j["type"] = "fluid";
+            j["radius"] = fluid->radius;
+            j["path"] = json::array();
+            for (const Eigen::Vector3d& p : fluid->path)
+                j["path"].push_back(vecJson(p));
         } else if (const auto* flow = std::get_if<FlowStroke>(&stroke)) {
             j["type"] = "flow";
             const FieldSpec& f = flow->field;
@@ -734,6 +777,9 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
                                 {"degrees_per_second", f.degreesPerSecond},
                                 {"radius", f.radius},
                                 {"falloff", f.falloff}}}};
+            else if (f.kind == FieldSpec::Kind::Sampled)
+                j["field"] = f.gridName.empty() ? json{{"vdb", f.file}}
+                                                : json{{"vdb", f.file}, {"grid", f.gridName}};
             else
                 j["field"] = fieldName(f.kind);
             j["from"] = flow->from;
@@ -770,6 +816,9 @@ StrokeScript withAbsoluteFiles(StrokeScript s, const std::string& scriptDir) {
             for (ToolSpec& t : slide->local.tools)
                 tools.push_back(&t);
         if (auto* keyed = std::get_if<KeyframedStroke>(&stroke)) tools.push_back(&keyed->tool);
+        if (auto* flow = std::get_if<FlowStroke>(&stroke);
+            flow && flow->field.kind == FieldSpec::Kind::Sampled)
+            absolute(flow->field.file);
         for (ToolSpec* t : tools)
             if (t->shape == ToolShapeKind::Baked) absolute(t->source.file);
     }

@@ -8,7 +8,11 @@
 //                  (shape: "ball" | "ellipsoid" | {"vdb": F, "grid": N} | {"mesh": F})
 //                  { "type": "swirl", "at": [..], "move": [..], "radius": r,
 //                    "ring": "discrete" | "convolution", "swirls": 8, "ball": rho },
-//                  { "type": "inflate", "at": [..], "radius": rho } ] }
+//                  { "type": "inflate", "at": [..], "radius": rho },
+//                  { "type": "flow", "field": "enright" | {"vdb": F, "grid": N} | ...,
+//                    "from": t0, "to": t1, "segments": n },
+//                  { "type": "fluid", "radius": r, "path": [[..], [..]] } ] }
+//     (and pinch, strangle, keyframed, slide: the README documents every field)
 //     (any stroke may add "duration": seconds, for films: sculpt/film.h)
 //
 // Reading validates everything, including that every segment's motion has a logarithm,
@@ -29,9 +33,10 @@ class ScriptError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// Parse and validate; `name` is used in messages (usually the file path). Baked tools'
-// files are read (relative names from `baseDir`, "" for the current directory), and a tool
-// that cannot be made refuses the script like any other mistake.
+// Parse and validate; `name` is used in messages (usually the file path). Baked tools' and
+// velocity fields' files are read (relative names from `baseDir`, "" for the current
+// directory), the swept fluid found (io/fluid_cache.h), and a tool or field that cannot be
+// made refuses the script like any other mistake.
 StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
                                const std::string& baseDir = "");
 // Read a file (its baked tools relative to it); a missing or unreadable file is a

@@ -125,6 +125,11 @@ AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path, const ope
         copy->insertMeta(it->first, *it->second);
     openvdb::GridCPtrVec grids{copy};
     grids.insert(grids.end(), beside.begin(), beside.end());
+    return prepareGrids(grids, path);
+}
+
+AtomicWrite prepareGrids(const openvdb::GridCPtrVec& grids, const std::string& path) {
+    initVdb();
     return AtomicWrite(path, [&](std::ostream& out) { FileWriter().writeTo(out, grids); });
 }
 

@@ -42,5 +42,7 @@ void writeLevelSet(const Grid& grid, const std::string& path);
 AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path,
                             const openvdb::MetaMap& meta = {},
                             const openvdb::GridCPtrVec& beside = {});
+// Any grids, in OpenVDB's file format, written and flushed but not yet in place.
+AtomicWrite prepareGrids(const openvdb::GridCPtrVec& grids, const std::string& path);
 
 } // namespace sweepers

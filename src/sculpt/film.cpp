@@ -16,13 +16,19 @@ namespace {
 std::size_t pathSegments(const Stroke& stroke) {
     if (const auto* sweep = std::get_if<SweepStroke>(&stroke))
         return std::max<std::size_t>(1, toSweep(*sweep).segmentCount());
+    if (const auto* fluid = std::get_if<FluidStroke>(&stroke))
+        return std::max<std::size_t>(1, fluid->path.size() - 1);
     return 1;
 }
 
 // Segment k of a sweep stroke done a fraction f of the way: a segment to the tools'
-// placements that far along their motions (3.48); null for another stroke, or where those
-// placements are not of the form T R S.
+// placements that far along their motions (3.48), or a fluid tool moved that far; null for
+// another stroke, or where those placements are not of the form T R S.
 std::unique_ptr<StepDeformation> sweptPart(const Stroke& stroke, std::size_t k, double f) {
+    // A fluid tool partway: the same tool moved that fraction of its segment.
+    if (const auto* fluid = std::get_if<FluidStroke>(&stroke); fluid && fluid->fluid)
+        return sweptFluidSegment(*fluid->fluid, fluid->radius, fluid->path[k],
+                                 fluid->path[k] + f * (fluid->path[k + 1] - fluid->path[k]));
     const auto* stroked = std::get_if<SweepStroke>(&stroke);
     if (!stroked) return nullptr;
     Sweep sweep = toSweep(*stroked);

@@ -93,6 +93,8 @@ std::size_t segmentCount(const Stroke& stroke, double voxelSize) {
         return toSweep(slide->local).segmentCount();
     if (const auto* flow = std::get_if<FlowStroke>(&stroke))
         return std::size_t(std::max(1, flow->segments));
+    if (const auto* fluid = std::get_if<FluidStroke>(&stroke))
+        return fluid->path.size() < 2 ? 0 : fluid->path.size() - 1;
     return 1;
 }
 
@@ -128,6 +130,12 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                                   ? s.segments
                                   : flowSegments(*field, s.from, s.to, surfacePoints(grid, 512));
                 parts = planFlow(field, s.from, s.to, n);
+            },
+            [&](const FluidStroke& s) {
+                if (!s.fluid) throw std::invalid_argument("the swept fluid was not solved");
+                for (std::size_t k = 0; k + 1 < s.path.size(); ++k)
+                    parts.push_back(
+                        sweptFluidSegment(*s.fluid, s.radius, s.path[k], s.path[k + 1]));
             },
         },
         stroke);

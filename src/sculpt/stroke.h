@@ -12,6 +12,7 @@
 //   keyframed - a tool whose target placement is keyed over time (3.6.1)
 //   slide   - a sweep in a local frame keyed over time (3.6.1)
 //   flow    - the shape carried by a velocity field over a span of time (chapter 4)
+//   fluid   - a ball pushed through the shape as through a fluid (swept fluid, 4.2)
 #pragma once
 
 #include <cstddef>
@@ -29,6 +30,7 @@
 #include "deform/step_deformation.h"
 #include "deform/strangle.h"
 #include "deform/sweep.h"
+#include "deform/swept_fluid.h"
 #include "deform/swirl.h"
 #include "levelset/vdb.h"
 
@@ -122,8 +124,17 @@ struct FlowStroke {
     int segments = 0;
 };
 
+// A ball of `radius` moved along `path` through the shape as through an incompressible fluid
+// (deform/swept_fluid.h): one resample a path segment, each the steps of 4.26 chained.
+struct FluidStroke {
+    double radius = 0.3;
+    std::vector<Eigen::Vector3d> path; // two points or more, no two successive ones equal
+    // The solution it sweeps, found by io/ (io/fluid_cache.h) when the script is read.
+    std::shared_ptr<const SweptFluid> fluid;
+};
+
 using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke, PinchStroke, StrangleStroke,
-                            KeyframedStroke, SlideStroke, FlowStroke>;
+                            KeyframedStroke, SlideStroke, FlowStroke, FluidStroke>;
 
 struct StrokeScript {
     int version = 1;
@@ -156,8 +167,9 @@ std::size_t segmentCount(const Stroke& stroke, double voxelSize);
 
 // The deformations of one stroke, in order: a sweep's segments, one swirl ring or
 // inflation (whose reach depends on the grid as it is when the stroke comes), or the
-// segments of a pinch or a strangle (whose sub-steps depend on the voxel size), or those of
-// a keyed stroke at its last key.
+// segments of a pinch or a strangle (whose sub-steps depend on the voxel size), those of
+// a keyed stroke at its last key, a flow's or a fluid tool's segments. Throws
+// std::invalid_argument for a fluid stroke whose solution was not found.
 std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke);
 
 } // namespace sweepers

@@ -11,6 +11,7 @@
 #include "grids.h"
 #include "io/stroke_script.h"
 #include "io/vdb_file.h"
+#include "levelset/band.h"
 #include "levelset/create.h"
 #include "levelset/fast_marching.h"
 #include "levelset/measure.h"
@@ -344,4 +345,44 @@ TEST(SculptController, AToolFromAFileGrabsAndIsRecordedByItsFile) {
     EXPECT_EQ(s.tool().shape, ToolShapeKind::Ball);
     const StrokeScript recorded = parseStrokeScript(formatStrokeScript(s.doc.script()), "recorded");
     EXPECT_EQ(differingVoxels(*applyScript(recorded, "."), s.doc.grid()), 0u);
+}
+
+TEST(SculptController, FluidModePushesTheClayAsAFluidAndKeepsItsVolume) {
+    // U, then a drag from the sphere's silhouette outward: each move becomes a fluid stroke
+    // of the tool's radius from the last position to this one (the swept fluid, 4.2).
+    Bench b;
+    b.ctl.onKey('U', false, false);
+    EXPECT_EQ(b.ctl.settings().mode, SculptMode::Fluid);
+    const double before = b.doc.mesher().enclosedVolume();
+    const double x0 = kWidth / 2.0, y0 = kHeight / 2.0;
+    // From a little inside the right of the silhouette.
+    double x = x0;
+    while (b.ctl.pick(x + 4, y0))
+        x += 4;
+    x -= 12;
+    b.ctl.onButton(0, true, x, y0, false);
+    ASSERT_EQ(b.ctl.drag(), DragKind::Sculpt);
+    for (int k = 1; k <= 3; ++k) {
+        b.ctl.onMove(x + 15 * k, y0);
+        b.ctl.step();
+    }
+    b.ctl.onButton(0, false, x + 45, y0, false);
+    b.ctl.wait();
+    b.ctl.step();
+    ASSERT_EQ(b.ctl.takeMessage(), "");
+    const auto& strokes = b.doc.script().strokes;
+    ASSERT_EQ(strokes.size(), 3u);
+    for (const Stroke& s : strokes) {
+        const auto* f = std::get_if<FluidStroke>(&s);
+        ASSERT_TRUE(f);
+        EXPECT_EQ(f->radius, b.ctl.settings().radius);
+        EXPECT_GT(f->path[1].x() - f->path[0].x(), 0.0);
+    }
+    const double after = b.doc.mesher().enclosedVolume();
+    std::printf("fluid drag: volume %.5f -> %.5f (%+.3f%%)\n", before, after,
+                100.0 * (after - before) / before);
+    EXPECT_LT(std::abs(after - before), 0.01 * before);
+    EXPECT_GT(activeWorldBox(b.doc.grid()).max.x(), 1.1); // pulled out to the right
+    const StrokeScript recorded = parseStrokeScript(formatStrokeScript(b.doc.script()), "fluid");
+    EXPECT_EQ(differingVoxels(*applyScript(recorded, "."), b.doc.grid()), 0u);
 }

@@ -171,8 +171,8 @@ TEST(FlowStroke, RoundTripsAndBadFlowsAreRefused) {
                           "segments": 0})"),
               "flow.json: /strokes/0/segments: expected a whole number from 1 to 4096, got 0");
     EXPECT_EQ(refusal(R"({"type": "flow", "field": "gale", "from": 0, "to": 1})"),
-              "flow.json: /strokes/0/field: expected \"enright\", \"vortex\" or "
-              "{\"rotation\": {...}}, got \"gale\"");
+              "flow.json: /strokes/0/field: expected \"enright\", \"vortex\", "
+              "{\"rotation\": {...}} or {\"vdb\": file}, got \"gale\"");
     EXPECT_EQ(refusal(R"({"type": "flow", "field": "enright", "from": 0, "to": 1e9})"),
               "flow.json: /strokes/0: the flow would take 3.01593e+10 sub-steps (more than "
               "100000): shorten its time or slow its field");
