@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The swept fluid and sampled velocity fields from the command line: the solution kept in
-# the cache directory as a VDB that independent readers see as a staggered vec3s grid, read
-# back by the next run, solved again when damaged; a fluid grab against a sweep on the same
+# the cache directory as a VDB that independent readers see as a staggered vec3s grid and
+# read back by the next run; a fluid grab against a sweep on the same
 # move; a velocity field written by pyopenvdb carrying a shape; bad velocity files refused in
 # one line with nothing written.
 . "$(dirname "$0")/common.sh" "$@"
@@ -9,7 +9,7 @@
 export SWEEPERS_CACHE=${SWEEPERS_CACHE:-$tmp/cache}
 cached=$SWEEPERS_CACHE/swept_fluid_72_r12_nu2_dt1.vdb
 
-# --- the cache: solved once, kept, read by others, read back, solved again when damaged --
+# --- the cache: solved once, kept, read by others, read back ----------------------------
 "$cli" check "$data/fluid/nose_fluid.json" >"$tmp/plan"
 grep -q "fluid, 10 sub-steps" "$tmp/plan" || fail "check: $(cat "$tmp/plan")"
 [ -s "$cached" ] || fail "the swept fluid was not kept in $cached"
@@ -31,12 +31,8 @@ before=$(stat -c %Y.%s "$cached")
 sleep 1
 "$cli" check "$data/fluid/nose_fluid.json" >/dev/null
 [ "$(stat -c %Y.%s "$cached")" = "$before" ] || fail "the cached fluid was solved again"
-# A damaged cache (a copy of ours, cut short) is solved again and replaced.
-mkdir "$tmp/damaged"
-head -c 100000 "$cached" >"$tmp/damaged/$(basename "$cached")"
-SWEEPERS_CACHE=$tmp/damaged "$cli" check "$data/fluid/nose_fluid.json" >/dev/null ||
-  fail "a damaged cache stopped the run"
-vdb_print "$tmp/damaged/$(basename "$cached")" >"$tmp/print" || fail "the damaged cache was not replaced"
+# (A damaged cache, one solved with other parameters, or one that cannot be written: the
+# unit tests, on small solutions.)
 
 # --- a fluid grab keeps the volume a sweep on the same move gains -------------------------
 for kind in fluid sweep; do

@@ -15,6 +15,7 @@
 #include "deform/swept_fluid.h"
 #include "io/fluid_cache.h"
 #include "io/stroke_script.h"
+#include "io/velocity_file.h"
 #include "random.h"
 
 using namespace sweepers;
@@ -240,6 +241,13 @@ TEST(SweptFluid, TheCacheKeepsTheSolutionAndSurvivesDamageAndReadOnlyPlaces) {
     EXPECT_NE(said.find("not a readable VDB file"), std::string::npos) << said;
     EXPECT_NE(said.find("kept it in"), std::string::npos) << said;
     EXPECT_GT(std::filesystem::file_size(fluidCachePath(b)), 1000u);
+    // A velocity file in its place that was not solved with these parameters: solved again.
+    FluidSpec d = a;
+    d.viscosity = 1.0;
+    writeVelocity(first->field->samples(), fluidCachePath(d), "velocity");
+    const auto fourth = sweptFluid(d, &said);
+    EXPECT_NE(said.find("was solved with other parameters"), std::string::npos) << said;
+    EXPECT_NE(fourth->centerSpeed, first->centerSpeed);
     // A cache that cannot be written costs the solve, nothing else.
     ::setenv("SWEEPERS_CACHE", "/dev/null/cache", 1);
     FluidSpec c = a;
