@@ -54,6 +54,13 @@ SampledField::SampledField(VelocitySamples samples) : s_(std::move(samples)) {
                     most.col(a) = most.col(a).cwiseMax((n[a] - v).cwiseAbs());
             }
     lipschitz_ = most.norm() / s_.spacing;
+    // Each component on its own, so that the four samples a row of the B-spline blends are
+    // next to each other in memory.
+    for (int c = 0; c < 3; ++c) {
+        components_[c].reserve(s_.count());
+        for (const Eigen::Vector3f& v : s_.values)
+            components_[c].push_back(v[c]);
+    }
     const Eigen::Vector3d top(d[0] - 1, d[1] - 1, d[2] - 1);
     support_ = Box(s_.origin, s_.origin + s_.spacing * top).expanded(2.5 * s_.spacing);
 }
@@ -66,11 +73,9 @@ double SampledField::blend(int c, const int base[3], const double* const w[3]) c
         // Inside the lattice (nearly everywhere): no sample to skip.
         for (int z = 0; z < 4; ++z)
             for (int y = 0; y < 4; ++y) {
-                const Eigen::Vector3f* row =
-                    &s_.values[s_.index(base[0], base[1] + y, base[2] + z)];
+                const float* row = &components_[c][s_.index(base[0], base[1] + y, base[2] + z)];
                 sum += w[1][y] * w[2][z] *
-                       (w[0][0] * row[0][c] + w[0][1] * row[1][c] + w[0][2] * row[2][c] +
-                        w[0][3] * row[3][c]);
+                       (w[0][0] * row[0] + w[0][1] * row[1] + w[0][2] * row[2] + w[0][3] * row[3]);
             }
         return sum;
     }
@@ -80,10 +85,10 @@ double SampledField::blend(int c, const int base[3], const double* const w[3]) c
         for (int y = 0; y < 4; ++y) {
             const int j = base[1] + y;
             if (j < 0 || j >= d[1]) continue;
-            const Eigen::Vector3f* row = &s_.values[s_.index(0, j, k)];
+            const float* row = &components_[c][s_.index(0, j, k)];
             for (int x = 0; x < 4; ++x) {
                 const int i = base[0] + x;
-                if (i >= 0 && i < d[0]) sum += w[0][x] * w[1][y] * w[2][z] * row[i][c];
+                if (i >= 0 && i < d[0]) sum += w[0][x] * w[1][y] * w[2][z] * row[i];
             }
         }
     }

@@ -56,6 +56,7 @@ class SampledField : public VelocityField {
     double blend(int c, const int base[3], const double* const w[3]) const;
 
     VelocitySamples s_;
+    std::array<std::vector<float>, 3> components_; // s_.values by component
     double lipschitz_ = 0.0;
     Box support_;
 };

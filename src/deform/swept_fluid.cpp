@@ -193,7 +193,10 @@ FluidSolution solveSweptFluid(const FluidSpec& spec) {
                 if ((Mac::position(0, i, j, k) - centre).norm() <= spec.ballRadius)
                     v0.at(0, i, j, k) = 1.0;
     // Convection by the method of characteristics: each face takes the value found where its
-    // characteristic was dt earlier (the monotone cubic keeps it within the data).
+    // characteristic was dt earlier (the monotone cubic keeps it within the data). Only near
+    // the ball: farther than its radius, the trace (dt at speed 1) and the cubic's reach (2
+    // faces) and a face for the trilinear trace, every value read is zero.
+    const double reach = spec.ballRadius + dt + 4.0;
     Mac u(n);
     for (int a = 0; a < 3; ++a)
         for (int k = 0; k <= n; ++k)
@@ -201,6 +204,7 @@ FluidSolution solveSweptFluid(const FluidSpec& spec) {
                 for (int i = 0; i <= n; ++i) {
                     if (!v0.inner(a, i, j, k)) continue;
                     const Eigen::Vector3d g = Mac::position(a, i, j, k);
+                    if ((g - centre).cwiseAbs().maxCoeff() > reach) continue;
                     u.at(a, i, j, k) = v0.sample(a, g - dt * v0.velocity(g), true);
                 }
     FluidSolution out;

@@ -36,14 +36,14 @@ sleep 1
 
 # --- a fluid grab keeps the volume a sweep on the same move gains -------------------------
 for kind in fluid sweep; do
-  "$cli" apply "$data/fluid/nose_$kind.json" -o "$tmp/$kind.vdb" --voxel-size 0.03125 2>"$tmp/$kind.log"
+  "$cli" apply "$data/fluid/nose_$kind.json" -o "$tmp/$kind.vdb" --voxel-size 0.0625 2>"$tmp/$kind.log"
 done
 "$py" - "$tmp/fluid.log" "$tmp/sweep.log" <<'PY'
 import re, sys
 def change(path):
     return float(re.search(r"volume .* \(([-+0-9.]+)%\)", open(path).read()).group(1))
 fluid, sweep = change(sys.argv[1]), change(sys.argv[2])
-print(f"nose at 1/32: fluid {fluid:+.3f}%, sweep {sweep:+.3f}%")
+print(f"nose at 1/16: fluid {fluid:+.3f}%, sweep {sweep:+.3f}%")
 assert abs(fluid) < 1.0 and 4 * abs(fluid) < abs(sweep), (fluid, sweep)
 PY
 

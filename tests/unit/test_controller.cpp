@@ -348,8 +348,9 @@ TEST(SculptController, AToolFromAFileGrabsAndIsRecordedByItsFile) {
 }
 
 TEST(SculptController, FluidModePushesTheClayAsAFluidAndKeepsItsVolume) {
-    // U, then a drag from the sphere's silhouette outward: each move becomes a fluid stroke
-    // of the tool's radius from the last position to this one (the swept fluid, 4.2).
+    // U, then a drag of two moves from the sphere's silhouette outward: each move becomes a
+    // fluid stroke of the tool's radius from the last position to this one (the swept fluid,
+    // 4.2).
     Bench b;
     b.ctl.onKey('U', false, false);
     EXPECT_EQ(b.ctl.settings().mode, SculptMode::Fluid);
@@ -362,16 +363,16 @@ TEST(SculptController, FluidModePushesTheClayAsAFluidAndKeepsItsVolume) {
     x -= 12;
     b.ctl.onButton(0, true, x, y0, false);
     ASSERT_EQ(b.ctl.drag(), DragKind::Sculpt);
-    for (int k = 1; k <= 3; ++k) {
-        b.ctl.onMove(x + 15 * k, y0);
+    for (int k = 1; k <= 2; ++k) {
+        b.ctl.onMove(x + 20 * k, y0);
         b.ctl.step();
     }
-    b.ctl.onButton(0, false, x + 45, y0, false);
+    b.ctl.onButton(0, false, x + 40, y0, false);
     b.ctl.wait();
     b.ctl.step();
     ASSERT_EQ(b.ctl.takeMessage(), "");
     const auto& strokes = b.doc.script().strokes;
-    ASSERT_EQ(strokes.size(), 3u);
+    ASSERT_EQ(strokes.size(), 2u);
     for (const Stroke& s : strokes) {
         const auto* f = std::get_if<FluidStroke>(&s);
         ASSERT_TRUE(f);
