@@ -20,7 +20,6 @@
 // fold-over free, and changing volume only by the field's divergence.
 #pragma once
 
-#include <functional>
 #include <memory>
 
 #include "deform/sampled_field.h"

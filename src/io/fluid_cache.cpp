@@ -93,8 +93,7 @@ std::shared_ptr<const SweptFluid> sweptFluid(const FluidSpec& spec, std::string*
         try {
             const VelocityFile file = readVelocityInChild(path, "velocity");
             if (solvedWith(*file.grid, spec)) {
-                fluid = std::make_shared<SweptFluid>(readVelocitySamples(path, "velocity"),
-                                                     spec.ballRadius);
+                fluid = std::make_shared<SweptFluid>(velocitySamples(file, path), spec.ballRadius);
                 note = "read the swept fluid from " + path;
             } else {
                 note = path + " was solved with other parameters; ";

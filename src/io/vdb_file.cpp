@@ -47,24 +47,11 @@ GridPtr readLevelSet(const std::string& path, const std::string& gridName) {
 }
 
 LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& gridName) {
-    initVdb();
-    if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
-    openvdb::GridPtrVecPtr grids;
-    try {
-        openvdb::io::File file(path);
-        file.open(/*delayLoad=*/false); // no memory map, no temporary copy: read it all now
-        grids = file.getGrids();
-        file.close();
-    } catch (const std::bad_alloc&) {
-        throw; // (in the reader's child process: its memory limit)
-    } catch (const std::exception& e) {
-        throw FileError(path + ": not a readable VDB file (" + e.what() + ")");
-    }
+    const openvdb::GridPtrVecPtr grids = readAllGrids(path);
     LevelSetFile out;
     std::vector<std::string> refusals; // of the level sets passed over
     for (const openvdb::GridBase::Ptr& base : *grids) {
-        const std::string what = "'" + base->getName() + "' (" + base->valueType() + ", " +
-                                 openvdb::GridBase::gridClassToString(base->getGridClass()) + ")";
+        const std::string what = describeGrid(*base);
         out.grids.push_back(what);
         GridPtr grid = base->getGridClass() == openvdb::GRID_LEVEL_SET
                            ? openvdb::gridPtrCast<Grid>(base)
@@ -91,13 +78,37 @@ LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& g
     for (const std::string& r : refusals)
         why += (why.empty() ? "" : "; ") + r;
     if (!why.empty()) throw FileError(path + ": no level set Sweepers can use (" + why + ")");
-    std::string seen;
-    for (const std::string& g : out.grids)
-        seen += (seen.empty() ? "" : ", ") + g;
-    const std::string holds =
-        seen.empty() ? std::string(" (it holds no grids)") : " (it holds " + seen + ")";
+    const std::string holds = holdsClause(out.grids);
     if (!gridName.empty()) throw FileError(path + ": no grid named '" + gridName + "'" + holds);
     throw FileError(path + ": no float level set in the file" + holds);
+}
+
+openvdb::GridPtrVecPtr readAllGrids(const std::string& path) {
+    initVdb();
+    if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
+    try {
+        openvdb::io::File file(path);
+        file.open(/*delayLoad=*/false); // no memory map, no temporary copy: read it all now
+        openvdb::GridPtrVecPtr grids = file.getGrids();
+        file.close();
+        return grids;
+    } catch (const std::bad_alloc&) {
+        throw; // (in the reader's child process: its memory limit)
+    } catch (const std::exception& e) {
+        throw FileError(path + ": not a readable VDB file (" + e.what() + ")");
+    }
+}
+
+std::string describeGrid(const openvdb::GridBase& grid) {
+    return "'" + grid.getName() + "' (" + grid.valueType() + ", " +
+           openvdb::GridBase::gridClassToString(grid.getGridClass()) + ")";
+}
+
+std::string holdsClause(const std::vector<std::string>& grids) {
+    std::string seen;
+    for (const std::string& g : grids)
+        seen += (seen.empty() ? "" : ", ") + g;
+    return seen.empty() ? std::string(" (it holds no grids)") : " (it holds " + seen + ")";
 }
 
 namespace {

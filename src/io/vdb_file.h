@@ -35,6 +35,12 @@ LevelSetFile readLevelSetFile(const std::string& path, const std::string& gridNa
 GridPtr readLevelSet(const std::string& path, const std::string& gridName = "");
 // The reader itself, in this process: for files we wrote, and for that child.
 LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& gridName = "");
+// Every grid of a VDB file, read whole (no memory map); FileError when it is not readable.
+openvdb::GridPtrVecPtr readAllGrids(const std::string& path);
+// A grid as messages name it: 'name' (type, class).
+std::string describeGrid(const openvdb::GridBase& grid);
+// " (it holds 'a' (float, level set), ...)" for the grids so described.
+std::string holdsClause(const std::vector<std::string>& grids);
 // Atomic (io/atomic_file.h): a failed write, a full disk included, keeps the old file.
 void writeLevelSet(const Grid& grid, const std::string& path);
 // The same, written and flushed but not yet in place: commit() puts it there. `meta` joins

@@ -2,9 +2,6 @@
 
 #include <cmath>
 #include <fstream>
-#include <new>
-
-#include <openvdb/io/File.h>
 
 #include "core/format.h"
 #include "io/isolated_read.h"
@@ -40,23 +37,10 @@ std::string unusable(const openvdb::Vec3SGrid& grid) {
 } // namespace
 
 VelocityFile readVelocityInProcess(const std::string& path, const std::string& gridName) {
-    initVdb();
-    if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
-    openvdb::GridPtrVecPtr grids;
-    try {
-        openvdb::io::File file(path);
-        file.open(/*delayLoad=*/false);
-        grids = file.getGrids();
-        file.close();
-    } catch (const std::bad_alloc&) {
-        throw; // (in the reader's child process: its memory limit)
-    } catch (const std::exception& e) {
-        throw FileError(path + ": not a readable VDB file (" + e.what() + ")");
-    }
+    const openvdb::GridPtrVecPtr grids = readAllGrids(path);
     VelocityFile out;
     for (const openvdb::GridBase::Ptr& base : *grids) {
-        const std::string what = "'" + base->getName() + "' (" + base->valueType() + ", " +
-                                 openvdb::GridBase::gridClassToString(base->getGridClass()) + ")";
+        const std::string what = describeGrid(*base);
         out.grids.push_back(what);
         if (out.grid || (!gridName.empty() && base->getName() != gridName)) continue;
         auto grid = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base);
@@ -75,24 +59,22 @@ VelocityFile readVelocityInProcess(const std::string& path, const std::string& g
         out.grid = grid;
     }
     if (out.grid) return out;
-    std::string seen;
-    for (const std::string& g : out.grids)
-        seen += (seen.empty() ? "" : ", ") + g;
-    const std::string holds =
-        seen.empty() ? std::string(" (it holds no grids)") : " (it holds " + seen + ")";
+    const std::string holds = holdsClause(out.grids);
     if (!gridName.empty()) throw FileError(path + ": no grid named '" + gridName + "'" + holds);
     throw FileError(path + ": no velocity grid (vec3s) in the file" + holds);
 }
 
 VelocitySamples readVelocitySamples(const std::string& path, const std::string& gridName) {
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
-    const VelocityFile file = readVelocityInChild(path, gridName);
+    return velocitySamples(readVelocityInChild(path, gridName), path);
+}
+
+VelocitySamples velocitySamples(const VelocityFile& file, const std::string& path) {
     const openvdb::Vec3SGrid& grid = *file.grid;
-    // The child checked the grid; what it sent is checked again where a damaged stream could
-    // make us allocate without bound.
-    if (const std::string why = unusable(grid); !why.empty())
-        throw FileError(path + ": velocity grid '" + file.name + "' " + why);
+    // The child checked the grid; its lattice size is checked again before it is allocated.
     const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
+    if (box.empty() || double(box.dim().x()) * box.dim().y() * box.dim().z() > kMostVelocitySamples)
+        throw FileError(path + ": velocity grid '" + file.name + "' " + unusable(grid));
     VelocitySamples s;
     s.dims = {box.dim().x(), box.dim().y(), box.dim().z()};
     const openvdb::Vec3d origin = grid.indexToWorld(box.min());

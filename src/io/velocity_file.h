@@ -29,6 +29,9 @@ VelocityFile readVelocityInProcess(const std::string& path, const std::string& g
 // (io/isolated_read.h) so that a damaged file cannot crash or hang the caller.
 VelocitySamples readVelocitySamples(const std::string& path, const std::string& gridName = "");
 
+// The same, from a file read already (`path` for messages).
+VelocitySamples velocitySamples(const VelocityFile& file, const std::string& path);
+
 constexpr double kMostVelocitySamples = 64.0 * 1024 * 1024; // 768 MB of float vectors
 
 // Writes the samples as a vec3s grid named `name` (zero samples left inactive), atomically
