@@ -1,14 +1,20 @@
-// Renormalization of a narrow-band level set by the fast marching method (thesis 5.3.3,
-// [Bae01]): after a deformation the values near the surface still locate it, but are no
-// longer distances. Fast marching rebuilds |grad phi| = 1 outward from the surface:
+// Renormalization of a narrow-band level set (thesis 5.3.3, [Bae01]): after a deformation
+// the values near the surface still locate it, but are no longer distances. The discrete
+// equations of fast marching rebuild |grad phi| = 1 outward from the surface:
 //
 //  1. seeds: every voxel with a face neighbour of the other sign gets phi / |grad phi|
 //     (central differences), capped by the distance to its nearest axis crossing. Values
 //     whose gradient is already unit within 1%, and values on or within two voxels of a
 //     feature one voxel thin, are kept: renormalizing twice changes nothing, and thin
 //     features do not drift. The sign of every voxel is kept.
-//  2. march inside and outside in increasing |phi| with the first-order upwind stencil or
-//     the second-order one (HAFMM) where two upwind neighbours are known.
+//  2. every other voxel gets the upwind solution from its neighbours of its own side: the
+//     first-order stencil, or the second-order one (HAFMM) where the voxel beyond the upwind
+//     neighbour is closer still. These are solved leaf by leaf, the leaves of one parity
+//     class in parallel, each in increasing order of distance, and changes at a leaf's
+//     border are passed to its neighbours until none is left (the fast iterative method, on
+//     leaves). It is the solution fast marching computes, without fast marching's single
+//     front, which visits the whole region in the order of distance, misses the cache at
+//     nearly every voxel and can use only two threads (one per side).
 //  3. voxels past the half-width are deactivated and set to +-background.
 //
 // Only a box of the grid is recomputed, on the leaves that overlap it; the voxels around
@@ -25,13 +31,13 @@ enum class FmmOrder { First = 1, Second = 2 };
 
 struct FmmStats {
     std::size_t seeds = 0;
-    std::size_t marched = 0; // voxels accepted by the march (seeds excluded)
+    std::size_t marched = 0; // voxels given a distance within the band (seeds excluded)
     std::size_t leaves = 0;  // leaves of the domain (overlapping the region and its margin)
 };
 
 // Recomputes the distances of the voxels inside `region` (index space). The result is a
 // valid narrow band of the grid's half-width there; the tree is pruned afterwards.
-// `interrupter` is polled between phases and during the march; a cancelled
+// `interrupter` is polled between phases and during the solve; a cancelled
 // renormalization throws Cancelled before it writes anything back.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region,
                      FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
