@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <array>
-#include <unordered_map>
 #include <utility>
 
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "levelset/local_tree.h"
 #include "levelset/stencils.h"
@@ -262,32 +262,80 @@ double SurfaceMesher::enclosedVolume() const {
 }
 
 TriangleMesh SurfaceMesher::weld() const {
-    TriangleMesh mesh;
-    // Only vertices on the faces of a leaf's cubes can appear in two chunks; the others (most
-    // of them) are added without a lookup.
-    std::unordered_map<std::uint64_t, int> index;
-    std::size_t vertices = 0;
+    // The chunks in order; vertices are numbered in that order, each chunk's in its own, and
+    // a vertex shared with an earlier chunk takes the number it got there. Vertex i of chunk
+    // c is vertex first[c] + i of all the chunks' vertices put end to end.
+    std::vector<std::pair<openvdb::Coord, const MeshChunk*>> list;
+    list.reserve(chunks_.size());
     for (const auto& [origin, chunk] : chunks_)
-        vertices += chunk.positions.size();
-    index.reserve(vertices / 2);
-    mesh.positions.reserve(vertices);
-    mesh.normals.reserve(vertices);
-    for (const auto& [origin, chunk] : chunks_) {
-        std::vector<int> local(chunk.positions.size());
-        for (std::size_t i = 0; i < chunk.positions.size(); ++i) {
-            const int next = int(mesh.positions.size());
-            const std::uint64_t key = chunk.edgeKeys[i];
-            const int id =
-                sharedAcrossLeaves(key, origin) ? index.emplace(key, next).first->second : next;
-            if (id == next) {
-                mesh.positions.push_back(chunk.positions[i]);
-                mesh.normals.push_back(chunk.normals[i]);
-            }
-            local[i] = id;
-        }
-        for (const Eigen::Vector3i& t : chunk.triangles)
-            mesh.triangles.emplace_back(local[t[0]], local[t[1]], local[t[2]]);
+        list.emplace_back(origin, &chunk);
+    const std::size_t n = list.size();
+    const auto forEachChunk = [&](const auto& body) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const auto& r) {
+            for (std::size_t c = r.begin(); c != r.end(); ++c)
+                body(c, *list[c].second);
+        });
+    };
+    std::vector<std::size_t> first(n + 1, 0), firstTriangle(n + 1, 0), shared(n + 1, 0);
+    forEachChunk([&](std::size_t c, const MeshChunk& chunk) {
+        for (const std::uint64_t key : chunk.edgeKeys)
+            shared[c + 1] += sharedAcrossLeaves(key, list[c].first);
+    });
+    for (std::size_t c = 0; c < n; ++c) {
+        first[c + 1] = first[c] + list[c].second->positions.size();
+        firstTriangle[c + 1] = firstTriangle[c] + list[c].second->triangles.size();
+        shared[c + 1] += shared[c];
     }
+    // 1. Only vertices on the faces of a leaf's cubes can appear in two chunks: those are
+    //    listed by name and sorted (then by chunk), and the first chunk with a name owns it.
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> named(shared[n]); // name, vertex
+    std::vector<std::uint32_t> owner(first[n]);
+    forEachChunk([&](std::size_t c, const MeshChunk& chunk) {
+        std::size_t k = shared[c];
+        for (std::size_t i = 0; i < chunk.edgeKeys.size(); ++i) {
+            const auto v = std::uint32_t(first[c] + i);
+            owner[v] = v;
+            if (sharedAcrossLeaves(chunk.edgeKeys[i], list[c].first))
+                named[k++] = {chunk.edgeKeys[i], v};
+        }
+    });
+    tbb::parallel_sort(named.begin(), named.end());
+    for (std::size_t i = 1; i < named.size(); ++i)
+        if (named[i].first == named[i - 1].first)
+            owner[named[i].second] = owner[named[i - 1].second];
+    // 2. Numbers for the vertices each chunk owns, from where the chunks before it end.
+    std::vector<std::size_t> owned(n + 1, 0);
+    forEachChunk([&](std::size_t c, const MeshChunk&) {
+        for (std::size_t v = first[c]; v < first[c + 1]; ++v)
+            owned[c + 1] += owner[v] == v;
+    });
+    for (std::size_t c = 0; c < n; ++c)
+        owned[c + 1] += owned[c];
+    TriangleMesh mesh;
+    mesh.positions.resize(owned[n]);
+    mesh.normals.resize(owned[n]);
+    mesh.triangles.resize(firstTriangle[n]);
+    std::vector<int> number(first[n]);
+    forEachChunk([&](std::size_t c, const MeshChunk& chunk) {
+        std::size_t next = owned[c];
+        for (std::size_t i = 0; i < chunk.positions.size(); ++i) {
+            const std::size_t v = first[c] + i;
+            if (owner[v] != v) continue;
+            number[v] = int(next);
+            mesh.positions[next] = chunk.positions[i];
+            mesh.normals[next] = chunk.normals[i];
+            ++next;
+        }
+    });
+    // 3. The others take their owners' numbers, and triangles are renumbered.
+    forEachChunk([&](std::size_t c, const MeshChunk& chunk) {
+        for (std::size_t v = first[c]; v < first[c + 1]; ++v)
+            if (owner[v] != v) number[v] = number[owner[v]];
+        std::size_t t = firstTriangle[c];
+        const int* local = &number[first[c]];
+        for (const Eigen::Vector3i& tri : chunk.triangles)
+            mesh.triangles[t++] = Eigen::Vector3i(local[tri[0]], local[tri[1]], local[tri[2]]);
+    });
     return mesh;
 }
 
