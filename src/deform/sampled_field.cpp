@@ -56,13 +56,23 @@ SampledField::SampledField(VelocitySamples samples) : s_(std::move(samples)) {
     lipschitz_ = most.norm() / s_.spacing;
     // Each component on its own, so that the four samples a row of the B-spline blends are
     // next to each other in memory.
+    // The vectors are not kept besides (up to 768 MB for the largest lattice a file may hold).
     for (int c = 0; c < 3; ++c) {
         components_[c].reserve(s_.count());
         for (const Eigen::Vector3f& v : s_.values)
             components_[c].push_back(v[c]);
     }
+    s_.values = {};
     const Eigen::Vector3d top(d[0] - 1, d[1] - 1, d[2] - 1);
     support_ = Box(s_.origin, s_.origin + s_.spacing * top).expanded(2.5 * s_.spacing);
+}
+
+VelocitySamples SampledField::samples() const {
+    VelocitySamples out = s_;
+    out.values.resize(s_.count());
+    for (std::size_t i = 0; i < out.values.size(); ++i)
+        out.values[i] = Eigen::Vector3f(components_[0][i], components_[1][i], components_[2][i]);
+    return out;
 }
 
 double SampledField::blend(int c, const int base[3], const double* const w[3]) const {

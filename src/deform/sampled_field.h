@@ -47,7 +47,8 @@ class SampledField : public VelocityField {
     Box support() const override { return support_; }
     // The field's divergence at p, exactly (the B-spline's own derivatives).
     double divergence(const Eigen::Vector3d& p) const;
-    const VelocitySamples& samples() const { return s_; }
+    // The samples it was made of (put together again from its components).
+    VelocitySamples samples() const;
 
   private:
     // Component c and, when `along` >= 0, its derivative along that axis (per world unit).
@@ -55,8 +56,8 @@ class SampledField : public VelocityField {
     // Component c blended over the 4 x 4 x 4 samples from `base` with weights w[axis].
     double blend(int c, const int base[3], const double* const w[3]) const;
 
-    VelocitySamples s_;
-    std::array<std::vector<float>, 3> components_; // s_.values by component
+    VelocitySamples s_;                            // the lattice; its values are in components_
+    std::array<std::vector<float>, 3> components_; // the samples, component by component
     double lipschitz_ = 0.0;
     Box support_;
 };

@@ -277,27 +277,29 @@ TriangleMesh SurfaceMesher::weld() const {
         });
     };
     std::vector<std::size_t> first(n + 1, 0), firstTriangle(n + 1, 0), shared(n + 1, 0);
-    forEachChunk([&](std::size_t c, const MeshChunk& chunk) {
-        for (const std::uint64_t key : chunk.edgeKeys)
-            shared[c + 1] += sharedAcrossLeaves(key, list[c].first);
-    });
     for (std::size_t c = 0; c < n; ++c) {
         first[c + 1] = first[c] + list[c].second->positions.size();
         firstTriangle[c + 1] = firstTriangle[c] + list[c].second->triangles.size();
-        shared[c + 1] += shared[c];
     }
     // 1. Only vertices on the faces of a leaf's cubes can appear in two chunks: those are
     //    listed by name and sorted (then by chunk), and the first chunk with a name owns it.
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> named(shared[n]); // name, vertex
     std::vector<std::uint32_t> owner(first[n]);
+    std::vector<char> onFace(first[n]);
+    forEachChunk([&](std::size_t c, const MeshChunk& chunk) {
+        for (std::size_t i = 0; i < chunk.edgeKeys.size(); ++i) {
+            const std::size_t v = first[c] + i;
+            owner[v] = std::uint32_t(v);
+            onFace[v] = sharedAcrossLeaves(chunk.edgeKeys[i], list[c].first);
+            shared[c + 1] += onFace[v];
+        }
+    });
+    for (std::size_t c = 0; c < n; ++c)
+        shared[c + 1] += shared[c];
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> named(shared[n]); // name, vertex
     forEachChunk([&](std::size_t c, const MeshChunk& chunk) {
         std::size_t k = shared[c];
-        for (std::size_t i = 0; i < chunk.edgeKeys.size(); ++i) {
-            const auto v = std::uint32_t(first[c] + i);
-            owner[v] = v;
-            if (sharedAcrossLeaves(chunk.edgeKeys[i], list[c].first))
-                named[k++] = {chunk.edgeKeys[i], v};
-        }
+        for (std::size_t i = 0; i < chunk.edgeKeys.size(); ++i)
+            if (onFace[first[c] + i]) named[k++] = {chunk.edgeKeys[i], std::uint32_t(first[c] + i)};
     });
     tbb::parallel_sort(named.begin(), named.end());
     for (std::size_t i = 1; i < named.size(); ++i)
