@@ -173,6 +173,22 @@ void set(Bits& bits, int off) {
     bits[std::size_t(off) >> 6] |= std::uint64_t(1) << (off & 63);
 }
 
+// The voxels of the leaf at `origin` that lie inside `box`.
+Bits inBox(const openvdb::CoordBBox& box, const openvdb::Coord& origin) {
+    const openvdb::Coord lo = openvdb::Coord::maxComponent(box.min() - origin, openvdb::Coord(0));
+    const openvdb::Coord hi = openvdb::Coord::minComponent(box.max() - origin, openvdb::Coord(7));
+    Bits out{};
+    if (lo.x() > hi.x() || lo.y() > hi.y() || lo.z() > hi.z()) return out;
+    const std::uint64_t row =
+        (std::uint64_t(0xff) >> (7 - hi.z())) & (std::uint64_t(0xff) << lo.z());
+    std::uint64_t word = 0;
+    for (int y = lo.y(); y <= hi.y(); ++y)
+        word |= row << (8 * y);
+    for (int x = lo.x(); x <= hi.x(); ++x)
+        out[std::size_t(x)] = word;
+    return out;
+}
+
 // The voxels of the face neighbour along `axis` (dir = +-1) of a leaf that lie within
 // `reach` steps of its voxels `bits`, in the neighbour's own offsets.
 Bits across(const Bits& bits, int axis, int dir, int reach) {
@@ -272,6 +288,41 @@ constexpr float kSolveTolerance = 1e-6f;
 // each (second-order updates are not monotone, so a bound guards against a cycle).
 constexpr int kMostPasses = 16, kMostRounds = 100;
 
+// The per-voxel arrays of a renormalization, kept by the calling thread for its next one:
+// on a virtual machine every first touch of a fresh page costs a fault of several
+// microseconds, which for the 5 MB of a drag segment at 1/128 came to a third of the stage.
+// Arrays for more than kKeptVoxels voxels are freed (a whole-grid renormalization should not
+// hold its memory for good).
+struct Scratch {
+    static constexpr std::size_t kKeptVoxels = std::size_t(1) << 24; // 144 MiB
+    std::unique_ptr<float[]> phi, dist;
+    std::unique_ptr<std::uint8_t[]> thin;
+    std::size_t capacity = 0;
+
+    // Scratch for n voxels: this thread's kept arrays when they are large enough.
+    static Scratch take(std::size_t n) {
+        Scratch s = std::move(kept());
+        kept().capacity = 0;
+        if (s.capacity < n) {
+            s.phi.reset(new float[n]);
+            s.dist.reset(new float[n]);
+            s.thin.reset(new std::uint8_t[n]);
+            s.capacity = n;
+        }
+        return s;
+    }
+    // Hands the arrays back to this thread for its next renormalization.
+    static void keep(Scratch&& s) {
+        if (s.capacity <= kKeptVoxels && s.capacity > kept().capacity) kept() = std::move(s);
+    }
+
+  private:
+    static Scratch& kept() {
+        thread_local Scratch scratch;
+        return scratch;
+    }
+};
+
 // What one thread needs to solve a leaf.
 struct LeafWork {
     Block block;
@@ -283,29 +334,43 @@ class Renormalizer {
     Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
                  FmmOrder order, Interrupter* interrupter)
         : b_(grid, region, 2), n_(b_.size()), h_(float(grid.voxelSize()[0])),
-          bg_(grid.background()), order_(order), interrupter_(interrupter), phi_(new float[n_]),
-          dist_(new float[n_]), thin_(new std::uint8_t[n_]), neg_(b_.leafCount(), Bits{}),
-          fixed_(b_.leafCount(), Bits{}), settled_(b_.leafCount(), Bits{}) {
+          bg_(grid.background()), order_(order), interrupter_(interrupter),
+          scratch_(Scratch::take(n_)), phi_(scratch_.phi.get()), dist_(scratch_.dist.get()),
+          thin_(scratch_.thin.get()), neg_(b_.leafCount(), Bits{}), fixed_(b_.leafCount(), Bits{}),
+          settled_(b_.leafCount(), Bits{}) {
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);
-            const bool whole = region.isInside(leaf.getNodeBoundingBox());
-            const auto* mask = only ? only->tree().probeConstLeaf(leaf.origin()) : nullptr;
+            const float* values = leaf.buffer().data();
+            float* phi = &phi_[l << 9];
+            float* dist = &dist_[l << 9];
+            std::memcpy(phi, values, sizeof(float) * kLeafVoxels);
             std::memset(&thin_[l << 9], 0, kLeafVoxels);
-            for (int off = 0; off < kLeafVoxels; ++off) {
-                const std::size_t i = (l << 9) + off;
-                const float p = leaf.getValue(off);
-                phi_[i] = p;
-                const bool inRegion = (whole || region.isInside(leaf.offsetToGlobalCoord(off))) &&
-                                      (!only || (mask && mask->isValueOn(off)));
-                // Free voxels start from their own values (their order is nearly right).
-                dist_[i] = std::abs(p) < bg_ ? std::abs(p) : kInf;
-                if (negative(p)) set(neg_[l], off);
-                if (!inRegion) set(fixed_[l], off);
+            Bits& neg = neg_[l];
+            for (int x = 0; x < 8; ++x) {
+                std::uint64_t word = 0;
+                for (int k = 0; k < 64; ++k) {
+                    const float p = phi[x * 64 + k];
+                    // Free voxels start from their own values (their order is nearly right).
+                    dist[x * 64 + k] = std::abs(p) < bg_ ? std::abs(p) : kInf;
+                    word |= std::uint64_t(negative(p)) << k;
+                }
+                neg[std::size_t(x)] = word;
             }
+            Bits free = inBox(region, leaf.origin());
+            if (only) {
+                const auto* mask = only->tree().probeConstLeaf(leaf.origin());
+                for (std::size_t x = 0; x < 8; ++x)
+                    free[x] &= mask ? mask->getValueMask().getWord<std::uint64_t>(x) : 0;
+            }
+            fixed_[l] = ~free;
             settled_[l] = fixed_[l];
         });
     }
+
+    ~Renormalizer() { Scratch::keep(std::move(scratch_)); }
+    Renormalizer(const Renormalizer&) = delete;
+    Renormalizer& operator=(const Renormalizer&) = delete;
 
     FmmStats run(const openvdb::CoordBBox& region, Grid& grid) {
         FmmStats stats;
@@ -746,11 +811,12 @@ class Renormalizer {
     const float h_, bg_;
     const FmmOrder order_;
     Interrupter* const interrupter_;
-    // Every entry is written by the constructor's parallel loop over the leaves, so these
-    // are allocated without the serial zeroing of a std::vector (8 MB for a drag segment).
-    std::unique_ptr<float[]> phi_;
-    std::unique_ptr<float[]> dist_; // the distance found so far (kInf: none yet)
-    std::unique_ptr<std::uint8_t[]> thin_;
+    // Every entry of the first n_ is written by the constructor's parallel loop over the
+    // leaves, so the arrays are never zeroed in one serial pass.
+    Scratch scratch_;
+    float* const phi_;
+    float* const dist_; // the distance found so far (kInf: none yet)
+    std::uint8_t* const thin_;
     // Per leaf: the voxels inside, the fixed ones (outside the region: boundary values), and
     // those settled before the solve (fixed, and the seeds).
     std::vector<Bits> neg_, fixed_, settled_;
