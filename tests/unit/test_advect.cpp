@@ -129,6 +129,22 @@ TEST(Advect, ResamplingEachSubStepReadsTheSignsTheSubStepBeforeLeft) {
     EXPECT_NEAR(m.volume, 4.0 / 3.0 * M_PI * 0.027, 0.01 * 4.0 / 3.0 * M_PI * 0.027);
 }
 
+// A tool holding the whole sphere squeezes it to 0.4 of its size along x: the inverse map
+// stretches space 2.5 times along x and not at all across, so the pre-images of the voxels
+// next to the new surface lie up to 1.5 * 2.5 voxels from the old one, and trilinear
+// sampling reads one more: the band is sampled 5 voxels wide, whatever the other axes do.
+TEST(Advect, TheBandIsWidenedByTheLargestStretch) {
+    const double h = 1.0 / 32;
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+    Placement squeezed;
+    squeezed.scale = Eigen::Vector3d(0.4, 1.0, 1.0);
+    Sweep sweep{{{std::make_shared<EllipsoidShape>(1.25), 0.4, {at({0, 0, 0}), squeezed}}}};
+    const AdvectStats stats = advectSegment(*g, SweepSegment(sweep, 0));
+    EXPECT_EQ(stats.widenedTo, 5.0);
+    const LevelSetMeasures m = measureLevelSet(*g);
+    EXPECT_NEAR(m.volume, 0.4 * 4.0 / 3.0 * M_PI, 0.01 * 0.4 * 4.0 / 3.0 * M_PI);
+}
+
 TEST(Advect, MonotoneCubicNeverOvershoots) {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(-1, 1);
