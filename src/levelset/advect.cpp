@@ -271,9 +271,9 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                 const LeafNode& leaf = *leaves[l];
                 leafStill[l] = still(leaf);
                 const bool whole = region.isInside(leaf.getNodeBoundingBox());
+                const auto crossing = crossingVoxels(leaf, acc);
                 for (auto it = leaf.cbeginValueOn(); it; ++it)
-                    if ((whole || region.isInside(it.getCoord())) &&
-                        nextToCrossing(leaf, it.pos(), acc))
+                    if (crossing.isOn(it.pos()) && (whole || region.isInside(it.getCoord())))
                         found[l].push_back(it.getCoord());
             }
         });

@@ -15,6 +15,11 @@ namespace sweepers {
 // its buffer, the others through `acc` (of the leaf's grid).
 bool nextToCrossing(const LeafNode& leaf, openvdb::Index offset, const Grid::ConstAccessor& acc);
 
+// The voxels of `leaf` next to the zero crossing (what nextToCrossing answers for each of
+// them, active or not), in the layout of the leaf's value mask: found 64 voxels at a time
+// from their signs and those of the neighbouring leaves' faces (read through `acc`).
+LeafNode::NodeMaskType crossingVoxels(const LeafNode& leaf, const Grid::ConstAccessor& acc);
+
 struct BandReport {
     std::size_t activeVoxels = 0;
     std::size_t nearInterface = 0; // active voxels within one voxel of the zero crossing

@@ -264,3 +264,28 @@ TEST(Advect, ACopyOfTheGridSculptsToTheSameVoxels) {
         EXPECT_EQ(sweepers::test::differingVoxels(s.grid(), copy.grid()), 0u) << "h = " << h;
     }
 }
+
+// The interface voxels a segment maps forward are found 64 at a time; they are exactly
+// the voxels nextToCrossing finds one by one, at leaf borders and next to tiles too.
+TEST(Advect, InterfaceVoxelsFoundByWordsAreThoseNextToTheCrossing) {
+    const double h = 1.0 / 40;
+    GridPtr g = makeSphere(Eigen::Vector3d(0.01, -0.02, 0.03), 0.6, h, 3);
+    // The band's leaves border tiles inside and outside; a ball a few voxels across adds
+    // voxels with the surface on both sides.
+    GridPtr ball = makeSphere(Eigen::Vector3d(0.9, 0.0, 0.0), 0.06, h, 3);
+    openvdb::tools::csgUnion(*g, *ball);
+    const auto acc = g->getConstAccessor();
+    std::size_t voxels = 0, crossing = 0, differ = 0;
+    for (auto leaf = g->tree().cbeginLeaf(); leaf; ++leaf) {
+        const auto words = crossingVoxels(*leaf, acc);
+        for (openvdb::Index off = 0; off < LeafNode::SIZE; ++off) {
+            const bool one = nextToCrossing(*leaf, off, acc);
+            differ += words.isOn(off) != one;
+            crossing += one;
+            ++voxels;
+        }
+    }
+    EXPECT_GT(crossing, 10000u);
+    EXPECT_GT(voxels, 4 * crossing);
+    EXPECT_EQ(differ, 0u);
+}
