@@ -5,7 +5,9 @@
 #include "levelset/local_tree.h"
 #include "levelset/monotone_cubic.h"
 
+#include <array>
 #include <cmath>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -92,6 +94,12 @@ class SampleSource {
             return openvdb::tools::BoxSampler::trilinearInterpolation(data, uvw);
         }
 
+        // The source leaf holding ijk (a copy, or the live grid's), or null over a tile.
+        const LeafNode* leafAt(const openvdb::Coord& ijk) const {
+            if (const LeafNode* leaf = copy(ijk)) return leaf;
+            return live_.probeConstLeaf(ijk);
+        }
+
       private:
         const LeafNode* copy(const openvdb::Coord& ijk) const {
             return copies_.probeConstLeaf(ijk);
@@ -102,6 +110,66 @@ class SampleSource {
   private:
     const Grid& live_;
     GridPtr copies_;
+};
+
+// The source values around one leaf, in a dense block: a leaf's pre-images of a drag lie
+// within a voxel or two of it, and their trilinear samples read the block by strides,
+// where each of them took a tree lookup, and eight where the cell crosses a leaf border.
+class SourceBlock {
+  public:
+    static constexpr int kRim = 2, kDim = int(LeafNode::DIM) + 2 * kRim;
+
+    // Fills the block around the leaf at `origin` from the source, a row of a leaf at a time.
+    void fill(const SampleSource::Accessor& acc, const openvdb::Coord& origin) {
+        min_ = origin.offsetBy(-kRim);
+        const openvdb::CoordBBox block(min_, min_.offsetBy(kDim - 1));
+        for (int a = -1; a <= 1; ++a)
+            for (int b = -1; b <= 1; ++b)
+                for (int c = -1; c <= 1; ++c) {
+                    const openvdb::Coord o = origin.offsetBy(a * 8, b * 8, c * 8);
+                    openvdb::CoordBBox part(o, o.offsetBy(7));
+                    part.intersect(block);
+                    const LeafNode* leaf = acc.leafAt(o);
+                    const float tile = leaf ? 0.0f : acc.getValue(o);
+                    for (int x = part.min().x(); x <= part.max().x(); ++x)
+                        for (int y = part.min().y(); y <= part.max().y(); ++y) {
+                            float* row = &values_[index(openvdb::Coord(x, y, part.min().z()))];
+                            const int n = part.max().z() - part.min().z() + 1;
+                            if (!leaf) {
+                                std::fill(row, row + n, tile);
+                                continue;
+                            }
+                            const float* from = leaf->buffer().data() +
+                                                LeafNode::coordToOffset({x, y, part.min().z()});
+                            std::copy(from, from + n, row);
+                        }
+                }
+    }
+
+    // Whether the cell with lowest corner ijk lies in the block.
+    bool holds(const openvdb::Coord& ijk) const {
+        const openvdb::Coord d = ijk - min_;
+        return d.x() >= 0 && d.y() >= 0 && d.z() >= 0 && d.x() < kDim - 1 && d.y() < kDim - 1 &&
+               d.z() < kDim - 1;
+    }
+    // Trilinear interpolation in the cell with lowest corner ijk (held), at offset uvw.
+    float trilinear(const openvdb::Coord& ijk, const openvdb::Vec3d& uvw) const {
+        float data[2][2][2];
+        const std::size_t o = index(ijk);
+        for (std::size_t i = 0; i < 2; ++i)
+            for (std::size_t j = 0; j < 2; ++j)
+                for (std::size_t k = 0; k < 2; ++k)
+                    data[i][j][k] = values_[o + i * kDim * kDim + j * kDim + k];
+        return openvdb::tools::BoxSampler::trilinearInterpolation(data, uvw);
+    }
+
+  private:
+    std::size_t index(const openvdb::Coord& ijk) const {
+        const openvdb::Coord d = ijk - min_;
+        return (std::size_t(d.x()) * kDim + std::size_t(d.y())) * kDim + std::size_t(d.z());
+    }
+    openvdb::Coord min_;
+    std::array<float, std::size_t(kDim) * kDim * kDim> values_;
 };
 
 // A leaf of the widened source where the old band did not reach: every voxel at the widened
@@ -129,11 +197,18 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> marks;
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
+    tbb::enumerable_thread_specific<std::unique_ptr<SourceBlock>> blocks;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
         const SampleSource::Accessor acc(source);
+        std::unique_ptr<SourceBlock>& block = blocks.local();
+        if (!block) block = std::make_unique<SourceBlock>();
         std::size_t n = 0;
         pollInterrupt(interrupter);
         for (std::size_t l = range.begin(); l != range.end(); ++l) {
+            bool filled = false; // the block is filled for the leaf's first sample
+            // The leaf as the source holds it (a copy: sampling writes this one), to tell
+            // which voxels the band grew into.
+            const LeafNode* before = acc.leafAt(leaves[l]->origin());
             for (auto it = leaves[l]->beginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
                 if (!box.isInside(ijk)) continue;
@@ -143,8 +218,15 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                 if (y != x || !sourceIsGrid) {
                     const auto sample = [&](const Eigen::Vector3d& at) {
                         const openvdb::Vec3d p = xform.worldToIndex(toVdb(at));
-                        return sampling == Sampling::Trilinear ? acc.trilinear(p)
-                                                               : float(sampleMonotoneCubic(acc, p));
+                        if (sampling != Sampling::Trilinear)
+                            return float(sampleMonotoneCubic(acc, p));
+                        const openvdb::Coord cell(openvdb::tools::local_util::floorVec3(p));
+                        if (!filled) {
+                            block->fill(acc, leaves[l]->origin());
+                            filled = true;
+                        }
+                        return block->holds(cell) ? block->trilinear(cell, p - cell.asVec3d())
+                                                  : acc.trilinear(p);
                     };
                     v = sample(y);
                     const double depth = tearing ? tearing->openedDepth(x) : 0.0;
@@ -155,7 +237,8 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                         v += float(depth);
                     }
                 }
-                if (v != *it || !acc.isValueOn(ijk)) marks.local().push_back(ijk);
+                if (v != *it || !(before ? before->isValueOn(it.pos()) : acc.isValueOn(ijk)))
+                    marks.local().push_back(ijk);
                 it.setValue(v);
                 ++n;
             }
