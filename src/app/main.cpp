@@ -6,6 +6,7 @@
 #include <tbb/global_control.h>
 
 #include "app/modeler.h"
+#include "core/memory.h"
 #include "io/stroke_script.h"
 
 static int run(int argc, char** argv) {
@@ -85,6 +86,7 @@ static int run(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
+    sweepers::keepFreedMemory();
     // What run does not catch itself (running out of memory while setting up).
     try {
         return run(argc, argv);

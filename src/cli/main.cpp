@@ -16,6 +16,7 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include "core/memory.h"
 #include "io/atomic_file.h"
 #include "io/film_files.h"
 #include "io/mesh_file.h"
@@ -784,6 +785,7 @@ static int run(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
+    sweepers::keepFreedMemory();
     // What run does not catch itself (running out of memory while setting up).
     try {
         return run(argc, argv);

@@ -4,6 +4,10 @@
 #include <fstream>
 #include <string>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 namespace sweepers {
 
 namespace {
@@ -34,6 +38,18 @@ bool restartPeakResident() {
     refs << "5"; // resets the peak resident set size to the current one
     refs.flush();
     return bool(refs);
+}
+
+void keepFreedMemory() {
+#if defined(__GLIBC__)
+    // Blocks below 32 MiB (glibc's largest threshold) come from the heap rather than from
+    // mappings of their own, which would go back to the kernel when freed; the heap is
+    // trimmed only when 256 MiB lie free at its top. A fixed threshold also stops glibc
+    // from moving it with each large block freed, which made the cost of a segment depend
+    // on what the one before had freed.
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);
+    mallopt(M_TRIM_THRESHOLD, 256 << 20);
+#endif
 }
 
 } // namespace sweepers

@@ -288,41 +288,6 @@ constexpr float kSolveTolerance = 1e-6f;
 // each (second-order updates are not monotone, so a bound guards against a cycle).
 constexpr int kMostPasses = 16, kMostRounds = 100;
 
-// The per-voxel arrays of a renormalization, kept by the calling thread for its next one:
-// on a virtual machine every first touch of a fresh page costs a fault of several
-// microseconds, which for the 5 MB of a drag segment at 1/128 came to a third of the stage.
-// Arrays for more than kKeptVoxels voxels are freed (a whole-grid renormalization should not
-// hold its memory for good).
-struct Scratch {
-    static constexpr std::size_t kKeptVoxels = std::size_t(1) << 24; // 144 MiB
-    std::unique_ptr<float[]> phi, dist;
-    std::unique_ptr<std::uint8_t[]> thin;
-    std::size_t capacity = 0;
-
-    // Scratch for n voxels: this thread's kept arrays when they are large enough.
-    static Scratch take(std::size_t n) {
-        Scratch s = std::move(kept());
-        kept().capacity = 0;
-        if (s.capacity < n) {
-            s.phi.reset(new float[n]);
-            s.dist.reset(new float[n]);
-            s.thin.reset(new std::uint8_t[n]);
-            s.capacity = n;
-        }
-        return s;
-    }
-    // Hands the arrays back to this thread for its next renormalization.
-    static void keep(Scratch&& s) {
-        if (s.capacity <= kKeptVoxels && s.capacity > kept().capacity) kept() = std::move(s);
-    }
-
-  private:
-    static Scratch& kept() {
-        thread_local Scratch scratch;
-        return scratch;
-    }
-};
-
 // What one thread needs to solve a leaf.
 struct LeafWork {
     Block block;
@@ -334,10 +299,9 @@ class Renormalizer {
     Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
                  FmmOrder order, Interrupter* interrupter)
         : b_(grid, region, 2), n_(b_.size()), h_(float(grid.voxelSize()[0])),
-          bg_(grid.background()), order_(order), interrupter_(interrupter),
-          scratch_(Scratch::take(n_)), phi_(scratch_.phi.get()), dist_(scratch_.dist.get()),
-          thin_(scratch_.thin.get()), neg_(b_.leafCount(), Bits{}), fixed_(b_.leafCount(), Bits{}),
-          settled_(b_.leafCount(), Bits{}) {
+          bg_(grid.background()), order_(order), interrupter_(interrupter), phi_(new float[n_]),
+          dist_(new float[n_]), thin_(new std::uint8_t[n_]), neg_(b_.leafCount(), Bits{}),
+          fixed_(b_.leafCount(), Bits{}), settled_(b_.leafCount(), Bits{}) {
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);
@@ -367,10 +331,6 @@ class Renormalizer {
             settled_[l] = fixed_[l];
         });
     }
-
-    ~Renormalizer() { Scratch::keep(std::move(scratch_)); }
-    Renormalizer(const Renormalizer&) = delete;
-    Renormalizer& operator=(const Renormalizer&) = delete;
 
     FmmStats run(const openvdb::CoordBBox& region, Grid& grid) {
         FmmStats stats;
@@ -811,12 +771,11 @@ class Renormalizer {
     const float h_, bg_;
     const FmmOrder order_;
     Interrupter* const interrupter_;
-    // Every entry of the first n_ is written by the constructor's parallel loop over the
-    // leaves, so the arrays are never zeroed in one serial pass.
-    Scratch scratch_;
-    float* const phi_;
-    float* const dist_; // the distance found so far (kInf: none yet)
-    std::uint8_t* const thin_;
+    // Every entry is written by the constructor's parallel loop over the leaves, so these
+    // are allocated without the serial zeroing of a std::vector (8 MB for a drag segment).
+    std::unique_ptr<float[]> phi_;
+    std::unique_ptr<float[]> dist_; // the distance found so far (kInf: none yet)
+    std::unique_ptr<std::uint8_t[]> thin_;
     // Per leaf: the voxels inside, the fixed ones (outside the region: boundary values), and
     // those settled before the solve (fixed, and the seeds).
     std::vector<Bits> neg_, fixed_, settled_;

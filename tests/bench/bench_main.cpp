@@ -17,6 +17,7 @@
 #include <openvdb/tools/VolumeToMesh.h>
 
 #include "bench.h"
+#include "core/memory.h"
 #include "deform/sweep.h"
 #include "levelset/advect.h"
 #include "levelset/band.h"
@@ -224,6 +225,7 @@ std::string csvQuote(std::string s) {
 
 int main(int argc, char** argv) {
     using namespace sweepers::bench;
+    sweepers::keepFreedMemory(); // as the executables do
     std::string csvPath = "sweepers-bench.csv";
     std::vector<char*> rest;
     for (int i = 0; i < argc; ++i) {

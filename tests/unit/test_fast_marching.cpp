@@ -2,7 +2,6 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -216,41 +215,4 @@ TEST(FastMarching, ThinRodSurvivesManyRenormalizations) {
     std::printf("[ fmm ] rod volume %.6g -> %.6g after 100 renormalizations (%+.2f%%)\n", v0, v1,
                 100 * (v1 - v0) / v0);
     EXPECT_NEAR(v1, v0, 0.05 * v0);
-}
-
-TEST(FastMarching, KeptArraysDoNotCarryIntoTheNextRenormalization) {
-    // A thread keeps its renormalization arrays for the next one. Three plates two voxels
-    // thick (every voxel of their band flagged thin) renormalized first leave larger arrays
-    // full of their own values and flags; a distorted sphere renormalized next on the same
-    // thread must come out exactly as on a thread that never renormalized anything.
-    const double h = 1.0 / 48;
-    auto plate = [&](const Eigen::Vector3d& p) {
-        const double z = std::abs(std::abs(p.z() - 0.1) - 0.5) - h; // at z = -0.4, 0.1, 0.6
-        return std::max(
-            {std::min(z, std::abs(p.z() - 0.1) - h), std::abs(p.x()) - 1.0, std::abs(p.y()) - 1.0});
-    };
-    auto sphere = [](const Eigen::Vector3d& p) { return p.norm() - 0.8; };
-    const openvdb::CoordBBox box = openvdb::CoordBBox::createCube({-52, -52, -52}, 104);
-    GridPtr first = gridFromSdf(plate, h, 3, box);
-    GridPtr start = gridFromSdf(sphere, h, 3, box);
-    distort(*start);
-    GridPtr fresh = start->deepCopy(), after = start->deepCopy();
-    std::thread([&] { renormalizeAll(*fresh, FmmOrder::Second); }).join();
-    std::thread([&] {
-        renormalizeAll(*first, FmmOrder::Second);
-        renormalizeAll(*after, FmmOrder::Second);
-    }).join();
-    ASSERT_GT(first->tree().leafCount(), start->tree().leafCount()); // its arrays are kept
-    std::size_t differ = 0, compared = 0;
-    const auto acc = after->getConstAccessor();
-    for (auto it = fresh->cbeginValueAll(); it; ++it) {
-        if (!it.isVoxelValue()) continue;
-        float v;
-        const bool on = acc.probeValue(it.getCoord(), v);
-        differ += on != it.isValueOn() || v != *it;
-        ++compared;
-    }
-    EXPECT_EQ(after->activeVoxelCount(), fresh->activeVoxelCount());
-    EXPECT_GT(compared, 100000u);
-    EXPECT_EQ(differ, 0u);
 }

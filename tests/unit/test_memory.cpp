@@ -1,8 +1,12 @@
 // The process's peak resident memory, and restarting its count for one piece of work.
+#include <cstdio>
 #include <cstring>
+
+#include <memory>
 
 #include <gtest/gtest.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
 
 #include "core/memory.h"
 
@@ -30,6 +34,47 @@ TEST(Memory, ThePeakCountRestartsFromWhatIsResidentNow) {
     const double restarted = peakResidentBytes();
     EXPECT_LT(restarted, withBlock - 0.75 * double(kBytes));
     EXPECT_GT(availableMemoryBytes(), 0.0);
+}
+
+// The process's minor page faults so far.
+long minorFaults() {
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    return usage.ru_minflt;
+}
+
+char* volatile sink; // keeps the compiler from leaving out the blocks written below
+
+// Allocates a block, writes every page of it, frees it.
+void writeBlock(std::size_t bytes) {
+    const std::unique_ptr<char[]> block(new char[bytes]);
+    sink = block.get();
+    std::memset(sink, 1, bytes);
+}
+
+// AddressSanitizer replaces the allocator, and glibc's settings with it.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
+TEST(Memory, FreedMemoryIsKeptForTheNextAllocation) {
+    if (kSanitized) GTEST_SKIP() << "AddressSanitizer's allocator does not take glibc's settings";
+    keepFreedMemory();
+    constexpr std::size_t kBytes = std::size_t(24) << 20, kPages = kBytes / 4096;
+    writeBlock(kBytes);
+    const long before = minorFaults();
+    writeBlock(kBytes); // the same pages again: no fault
+    const long faults = minorFaults() - before;
+    std::printf("[ memory ] %ld page faults writing %zu pages a second time\n", faults, kPages);
+    EXPECT_LT(faults, long(kPages / 20));
 }
 
 } // namespace
