@@ -119,31 +119,13 @@ class SourceBlock {
   public:
     static constexpr int kRim = 2, kDim = int(LeafNode::DIM) + 2 * kRim;
 
-    // Fills the block around the leaf at `origin` from the source, a row of a leaf at a time.
+    // Fills the block around the leaf at `origin` from the source.
     void fill(const SampleSource::Accessor& acc, const openvdb::Coord& origin) {
         min_ = origin.offsetBy(-kRim);
-        const openvdb::CoordBBox block(min_, min_.offsetBy(kDim - 1));
-        for (int a = -1; a <= 1; ++a)
-            for (int b = -1; b <= 1; ++b)
-                for (int c = -1; c <= 1; ++c) {
-                    const openvdb::Coord o = origin.offsetBy(a * 8, b * 8, c * 8);
-                    openvdb::CoordBBox part(o, o.offsetBy(7));
-                    part.intersect(block);
-                    const LeafNode* leaf = acc.leafAt(o);
-                    const float tile = leaf ? 0.0f : acc.getValue(o);
-                    for (int x = part.min().x(); x <= part.max().x(); ++x)
-                        for (int y = part.min().y(); y <= part.max().y(); ++y) {
-                            float* row = &values_[index(openvdb::Coord(x, y, part.min().z()))];
-                            const int n = part.max().z() - part.min().z() + 1;
-                            if (!leaf) {
-                                std::fill(row, row + n, tile);
-                                continue;
-                            }
-                            const float* from = leaf->buffer().data() +
-                                                LeafNode::coordToOffset({x, y, part.min().z()});
-                            std::copy(from, from + n, row);
-                        }
-                }
+        copyBox(
+            openvdb::CoordBBox(min_, min_.offsetBy(kDim - 1)), values_.data(),
+            [&](const openvdb::Coord& o) { return acc.leafAt(o); },
+            [&](const openvdb::Coord& o) { return acc.getValue(o); });
     }
 
     // Whether the cell with lowest corner ijk lies in the block.

@@ -4,9 +4,10 @@
 // The leaves overlapping a box are found by descending the tree through the internal
 // nodes that overlap it; signs of inactive values are re-derived (signed flood fill) in the
 // leaves and internal nodes overlapping the box, bottom up; leaves left without an active
-// voxel are replaced by tiles.
+// voxel are replaced by tiles; the values of a box are copied into a dense array.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <type_traits>
 #include <vector>
@@ -33,6 +34,47 @@ template <typename TreeT> auto leavesIn(TreeT& tree, const openvdb::CoordBBox& b
         }
     }
     return out;
+}
+
+// Copies the values of `box` into `out`, a dense array indexed ((x * ny) + y) * nz + z
+// from box.min(), a leaf's row at a time: `leafAt(origin)` gives the leaf at that origin (or
+// null), `valueAt(ijk)` the value of a tile or the background where there is none. What
+// reads every voxel around a leaf (meshing, sampling) reads its neighbours this way instead
+// of one tree lookup per voxel.
+template <typename LeafAt, typename ValueAt>
+void copyBox(const openvdb::CoordBBox& box, float* out, const LeafAt& leafAt,
+             const ValueAt& valueAt) {
+    constexpr int kDim = int(LeafNode::DIM);
+    const openvdb::Coord size = box.dim();
+    const auto at = [&](int x, int y, int z) {
+        return (std::size_t(x - box.min().x()) * std::size_t(size.y()) +
+                std::size_t(y - box.min().y())) *
+                   std::size_t(size.z()) +
+               std::size_t(z - box.min().z());
+    };
+    const openvdb::Coord first(box.min().x() & ~(kDim - 1), box.min().y() & ~(kDim - 1),
+                               box.min().z() & ~(kDim - 1));
+    for (int ox = first.x(); ox <= box.max().x(); ox += kDim)
+        for (int oy = first.y(); oy <= box.max().y(); oy += kDim)
+            for (int oz = first.z(); oz <= box.max().z(); oz += kDim) {
+                const openvdb::Coord o(ox, oy, oz);
+                openvdb::CoordBBox part(o, o.offsetBy(kDim - 1));
+                part.intersect(box);
+                const LeafNode* leaf = leafAt(o);
+                const float tile = leaf ? 0.0f : float(valueAt(o));
+                const int z0 = part.min().z(), n = part.max().z() - z0 + 1;
+                for (int x = part.min().x(); x <= part.max().x(); ++x)
+                    for (int y = part.min().y(); y <= part.max().y(); ++y) {
+                        float* row = out + at(x, y, z0);
+                        if (!leaf) {
+                            std::fill(row, row + n, tile);
+                            continue;
+                        }
+                        const float* from =
+                            leaf->buffer().data() + LeafNode::coordToOffset({x, y, z0});
+                        std::copy(from, from + n, row);
+                    }
+            }
 }
 
 // Re-derives the signs of the inactive values in the leaves and internal nodes that

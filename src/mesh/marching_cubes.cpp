@@ -40,17 +40,13 @@ class LeafBlock {
     static constexpr int kDim = int(LeafNode::DIM), kSpan = kDim + 3;
 
     LeafBlock(const Grid::ConstAccessor& acc, const LeafNode& leaf) : origin_(leaf.origin()) {
-        for (int x = 0; x < kSpan; ++x)
-            for (int y = 0; y < kSpan; ++y)
-                for (int z = 0; z < kSpan; ++z) {
-                    const int lx = x - 1, ly = y - 1, lz = z - 1; // leaf-local coordinates
-                    const bool inside =
-                        lx >= 0 && lx < kDim && ly >= 0 && ly < kDim && lz >= 0 && lz < kDim;
-                    values_[(x * kSpan + y) * kSpan + z] =
-                        inside ? leaf.getValue(openvdb::Index((lx * kDim + ly) * kDim + lz))
-                               : acc.getValue(origin_.offsetBy(lx, ly, lz));
-                }
+        const openvdb::Coord min = origin_.offsetBy(-1);
+        copyBox(
+            openvdb::CoordBBox(min, min.offsetBy(kSpan - 1)), values_.data(),
+            [&](const openvdb::Coord& o) { return acc.probeConstLeaf(o); },
+            [&](const openvdb::Coord& o) { return acc.getValue(o); });
     }
+
     float getValue(const openvdb::Coord& c) const {
         const openvdb::Coord l = c - origin_;
         return values_[((l.x() + 1) * kSpan + l.y() + 1) * kSpan + l.z() + 1];
