@@ -51,6 +51,10 @@ class MotionLog {
     Eigen::Matrix4d exp() const;
     // exp(L) . p, closed form where the kind has one.
     Eigen::Vector3d applyExp(const Eigen::Vector3d& p) const;
+    // exp(w L) . p: (L * w).applyExp(p), to the bit, without a scaled copy for a translation.
+    Eigen::Vector3d applyExp(double w, const Eigen::Vector3d& p) const {
+        return kind_ == Kind::Translation ? Eigen::Vector3d(p + u_ * w) : (*this * w).applyExp(p);
+    }
     // L . p, the velocity of p; the sub-step bounds 3.14 / 3.19 measure it.
     Eigen::Vector3d velocity(const Eigen::Vector3d& p) const { return linear_ * p + u_; }
 

@@ -143,6 +143,21 @@ bool SweepSegment::identityOn(const Box& box) const {
     return true;
 }
 
+Eigen::Vector3d SweepSegment::inverseStep(int k, const Eigen::Vector3d& p) const {
+    if (tools_.size() != 1) return StepDeformation::inverseStep(k, p);
+    const double phi = oneToolInfluence(k, p);
+    return phi == 0.0 ? p : tools_[0].stepLog.applyExp(-phi, p); // 5.18
+}
+
+ForwardResult SweepSegment::forwardStep(int k, const Eigen::Vector3d& q, double tolerance) const {
+    if (tools_.size() != 1) return StepDeformation::forwardStep(k, q, tolerance);
+    // p = exp(phi(p) L) q, iterated (INVERTFASTER, 5.4.1).
+    return iterateForward(q, tolerance, forwardMaxIterations_, [&](const Eigen::Vector3d& p) {
+        const double phi = oneToolInfluence(k, p);
+        return phi == 0.0 ? q : tools_[0].stepLog.applyExp(phi, q);
+    });
+}
+
 std::optional<MotionLog> SweepSegment::stepLog(int k, const Eigen::Vector3d& p) const {
     if (!stepBoxes_[k].contains(p)) return std::nullopt;
     // Normalized blend 3.17 / 5.19: c = (1 - prod(1 - phi_j)) / sum(phi_j).

@@ -66,11 +66,24 @@ class SweepSegment : public StepDeformation {
     // Also true where the box lies in the affected box but beyond every tool's coating.
     bool identityOn(const Box& box) const override;
 
+    // For one tool, the blend is its influence times its log (3.17 with c phi = phi): the
+    // sub-steps apply that directly. Several tools take the blend of stepLog.
+    Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const override;
+    ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
+                              double tolerance = 0.0) const override;
+
   protected:
     // The normalized blend of sub-step k at p (tools at tau_{k+1}).
     std::optional<MotionLog> stepLog(int k, const Eigen::Vector3d& p) const override;
 
   private:
+    // The influence phi of the one tool at sub-step k (tools at tau_{k+1}) at p.
+    double oneToolInfluence(int k, const Eigen::Vector3d& p) const {
+        return stepBoxes_[std::size_t(k)].contains(p)
+                   ? tools_[0].placed[std::size_t(k) + 1]->influence(p)
+                   : 0.0;
+    }
+
     struct ToolPlan {
         MotionLog log;                                   // log M_j for the whole segment
         MotionLog stepLog;                               // log M_j / s

@@ -99,6 +99,30 @@ TEST(Sweep, InverseUndoesForward) {
     std::printf("[ residual ] worst relative to tool size: %.3g\n", worst);
 }
 
+// A sweep of one tool applies its influence times its log directly; the blend of several
+// tools (3.17), which the base class applies, reduces to that: both give the same points to
+// the bit, for every kind of motion.
+TEST(Sweep, OneToolStepsAreTheBlendsOfOne) {
+    Rng rng(7);
+    for (const Case& c : cases()) {
+        const SweepSegment seg(c.sweep, 0);
+        if (seg.toolCount() != 1) continue;
+        const Box& box = seg.affectedBox();
+        int moved = 0;
+        for (int i = 0; i < 500; ++i) {
+            const Eigen::Vector3d p = rng.inBox(box.min, box.max);
+            for (int k = 0; k < seg.steps(); ++k) {
+                const Eigen::Vector3d q = seg.inverseStep(k, p);
+                ASSERT_EQ(q, seg.StepDeformation::inverseStep(k, p)) << c.name;
+                ASSERT_EQ(seg.forwardStep(k, p).p, seg.StepDeformation::forwardStep(k, p).p)
+                    << c.name;
+                moved += q != p;
+            }
+        }
+        EXPECT_GT(moved, 100) << c.name;
+    }
+}
+
 TEST(Sweep, SegmentMapIsFoldOverFree) {
     // Random tools and motions; the finite-difference Jacobian determinant of the composed
     // segment map is positive everywhere in the affected box.
