@@ -4,6 +4,21 @@
 
 namespace sweepers {
 
+// Whether this build runs under AddressSanitizer, which replaces the allocator (glibc's
+// settings do not reach it) and reserves terabytes of address space. GCC says so with
+// __SANITIZE_ADDRESS__, clang with __has_feature.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr bool kAddressSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+constexpr bool kAddressSanitizer = true;
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+#else
+constexpr bool kAddressSanitizer = false;
+#endif
+
 // The kernel's estimate of memory available without swapping (MemAvailable), in bytes;
 // 0 when it cannot be read.
 double availableMemoryBytes();

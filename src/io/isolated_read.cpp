@@ -31,20 +31,9 @@ namespace sweepers {
 namespace {
 
 constexpr const char* kMarker = "--sweepers-read-grid-for-parent";
-// AddressSanitizer reserves terabytes of address space, so the child's memory limit cannot
-// be a limit on its address space there (GCC says so with __SANITIZE_ADDRESS__, clang with
-// __has_feature): the sanitizer's own limit on the resident memory stands in for it.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
+// Under AddressSanitizer (kAddressSanitizer, core/memory.h) the child's memory limit cannot
+// be a limit on its address space, which the sanitizer reserves by terabytes: the
+// sanitizer's own limit on the resident memory stands in for it.
 // Child exit codes besides 0 (the grid was sent). Not 1 for a refusal: a sanitizer that
 // catches the reader overrunning a buffer ends the child with 1, and that is damage.
 constexpr int kRefused = 65, kOutOfMemory = 3, kCannotStart = 127;

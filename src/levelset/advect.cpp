@@ -7,7 +7,6 @@
 
 #include <array>
 #include <cmath>
-#include <memory>
 #include <utility>
 #include <vector>
 
@@ -179,11 +178,10 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> marks;
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
-    tbb::enumerable_thread_specific<std::unique_ptr<SourceBlock>> blocks;
+    tbb::enumerable_thread_specific<SourceBlock> blocks;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
         const SampleSource::Accessor acc(source);
-        std::unique_ptr<SourceBlock>& block = blocks.local();
-        if (!block) block = std::make_unique<SourceBlock>();
+        SourceBlock& block = blocks.local();
         std::size_t n = 0;
         pollInterrupt(interrupter);
         for (std::size_t l = range.begin(); l != range.end(); ++l) {
@@ -204,11 +202,11 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                             return float(sampleMonotoneCubic(acc, p));
                         const openvdb::Coord cell(openvdb::tools::local_util::floorVec3(p));
                         if (!filled) {
-                            block->fill(acc, leaves[l]->origin());
+                            block.fill(acc, leaves[l]->origin());
                             filled = true;
                         }
-                        return block->holds(cell) ? block->trilinear(cell, p - cell.asVec3d())
-                                                  : acc.trilinear(p);
+                        return block.holds(cell) ? block.trilinear(cell, p - cell.asVec3d())
+                                                 : acc.trilinear(p);
                     };
                     v = sample(y);
                     const double depth = tearing ? tearing->openedDepth(x) : 0.0;

@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <type_traits>
 
 #include <openvdb/tools/Diagnostics.h>
 #include <openvdb/tree/LeafManager.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
+#include "levelset/leaf_words.h"
 #include "levelset/stencils.h"
 
 namespace sweepers {
@@ -35,8 +37,7 @@ bool nextToCrossing(const LeafNode& leaf, openvdb::Index offset, const Grid::Con
 
 namespace {
 
-using Word = std::uint64_t;
-constexpr Word kZ0 = 0x0101010101010101ull, kZ7 = kZ0 << 7; // the voxels at z = 0, z = 7
+using leafwords::Word;
 
 // Bit k of the word: whether v[first + k * stride] is inside, for k < count.
 Word signs(const float* v, std::size_t first, std::size_t count, std::size_t stride) {
@@ -49,55 +50,44 @@ Word signs(const float* v, std::size_t first, std::size_t count, std::size_t str
 } // namespace
 
 LeafNode::NodeMaskType crossingVoxels(const LeafNode& leaf, const Grid::ConstAccessor& acc) {
-    // Offsets are x * 64 + y * 8 + z, so word x of a mask holds the slab x, bit y * 8 + z.
     const float* v = leaf.buffer().data();
     Word own[8];
     for (std::size_t x = 0; x < 8; ++x)
         own[x] = signs(v, 64 * x, 64, 1);
-    // The face neighbour along an axis: its values, or none where the grid holds a tile there
-    // (a tile has one sign: `tileInside`).
-    const auto neighbour = [&](int axis, int dir, bool& tileInside) -> const float* {
-        openvdb::Coord o = leaf.origin();
-        o[axis] += dir * int(LeafNode::DIM);
-        if (const LeafNode* n = acc.probeConstLeaf(o)) return n->buffer().data();
-        tileInside = acc.getValue(o) < 0.0f;
-        return nullptr;
-    };
     LeafNode::NodeMaskType out;
-    const auto add = [&](std::size_t x, Word w) {
-        out.getWord<Word>(openvdb::Index(x)) |= w ^ own[x];
-    };
-    for (const int dir : {-1, 1}) {
-        bool tile = false;
-        // Along x: the neighbouring slab, or the neighbour leaf's facing slab.
-        const float* n = neighbour(0, dir, tile);
-        const Word face = n ? signs(n, dir > 0 ? 0 : 7 * 64, 64, 1) : (tile ? ~Word(0) : 0);
-        for (std::size_t x = 0; x < 8; ++x) {
-            const std::size_t t = x + std::size_t(dir); // wraps past 7 when dir is -1 at 0
-            add(x, t < 8 ? own[t] : face);
-        }
-        // Along y: rows of eight bits; the facing row of the neighbour at y = 0 or 7.
-        n = neighbour(1, dir, tile);
-        for (std::size_t x = 0; x < 8; ++x) {
-            const Word row =
-                n ? signs(n, 64 * x + (dir > 0 ? 0 : 56), 8, 1) : (tile ? Word(0xff) : 0);
-            add(x, dir > 0 ? (own[x] >> 8) | (row << 56) : (own[x] << 8) | row);
-        }
-        // Along z: within each row; the neighbour's voxels at z = 0 or 7, one per row.
-        n = neighbour(2, dir, tile);
-        for (std::size_t x = 0; x < 8; ++x) {
-            Word column = 0; // bit y * 8 at z = 0
-            if (n) {
-                const Word bits = signs(n, 64 * x + (dir > 0 ? 0 : 7), 8, 8);
-                for (std::size_t y = 0; y < 8; ++y)
-                    column |= ((bits >> y) & 1) << (8 * y);
-            } else if (tile) {
-                column = kZ0;
+    const auto along = [&](auto axis) {
+        constexpr int A = decltype(axis)::value;
+        for (const int dir : {-1, 1}) {
+            openvdb::Coord o = leaf.origin();
+            o[A] += dir * int(LeafNode::DIM);
+            // The facing layer of the next leaf, or a tile's one sign where there is none.
+            const LeafNode* next = acc.probeConstLeaf(o);
+            const float* n = next ? next->buffer().data() : nullptr;
+            const bool tileInside = !next && acc.getValue(o) < 0.0f;
+            for (int x = 0; x < 8; ++x) {
+                const std::size_t sx = std::size_t(x);
+                Word facing = 0;
+                if constexpr (A == 0) {
+                    facing = n ? signs(n, dir > 0 ? 0 : 7 * 64, 64, 1) : tileInside ? ~Word(0) : 0;
+                } else if constexpr (A == 1) {
+                    facing = n            ? signs(n, 64 * sx + (dir > 0 ? 0 : 56), 8, 1)
+                             : tileInside ? leafwords::kY0
+                                          : 0;
+                } else if (n) {
+                    const Word bits = signs(n, 64 * sx + (dir > 0 ? 0 : 7), 8, 8); // bit y
+                    for (std::size_t y = 0; y < 8; ++y)
+                        facing |= ((bits >> y) & 1) << (8 * y);
+                } else {
+                    facing = tileInside ? leafwords::kZ0 : 0;
+                }
+                out.getWord<Word>(openvdb::Index(x)) |=
+                    leafwords::stepped<A>(own, x, dir, facing) ^ own[x];
             }
-            add(x,
-                dir > 0 ? ((own[x] >> 1) & ~kZ7) | (column << 7) : ((own[x] << 1) & ~kZ0) | column);
         }
-    }
+    };
+    along(std::integral_constant<int, 0>{});
+    along(std::integral_constant<int, 1>{});
+    along(std::integral_constant<int, 2>{});
     return out;
 }
 

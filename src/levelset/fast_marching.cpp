@@ -17,6 +17,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
 
 namespace sweepers {
@@ -97,26 +98,22 @@ class Domain {
     template <int A>
     void stepped(const std::vector<Bits>& sets, std::size_t l, int dir, Bits& out,
                  Bits& valid) const {
-        constexpr std::uint64_t z0 = 0x0101010101010101ull, z7 = z0 << 7;
-        constexpr std::uint64_t y0 = 0xffull, y7 = y0 << 56;
-        const Bits& w = sets[l];
+        using namespace leafwords;
+        const Word* w = sets[l].data();
         const int nl = neighbours_[l][2 * A + (dir > 0)];
-        const Bits* n = nl < 0 ? nullptr : &sets[std::size_t(nl)];
+        const Word* n = nl < 0 ? nullptr : sets[std::size_t(nl)].data();
         for (int x = 0; x < 8; ++x) {
-            if constexpr (A == 2) { // z: within rows of eight bits
-                out[x] = dir > 0 ? ((w[x] >> 1) & ~z7) | (n ? ((*n)[x] & z0) << 7 : 0)
-                                 : ((w[x] << 1) & ~z0) | (n ? ((*n)[x] & z7) >> 7 : 0);
-                valid[x] = n ? ~0ull : ~(dir > 0 ? z7 : z0);
-            } else if constexpr (A == 1) { // y: rows of a word
-                out[x] = dir > 0 ? (w[x] >> 8) | (n ? ((*n)[x] & y0) << 56 : 0)
-                                 : (w[x] << 8) | (n ? (*n)[x] >> 56 : 0);
-                valid[x] = n ? ~0ull : ~(dir > 0 ? y7 : y0);
-            } else { // x: words of a leaf
-                const int t = x + dir;
-                const bool inside = t >= 0 && t < 8;
-                out[x] = inside ? w[std::size_t(t)] : (n ? (*n)[dir > 0 ? 0 : 7] : 0);
-                valid[x] = inside || n ? ~0ull : 0;
-            }
+            out[x] = leafwords::stepped<A>(w, x, dir, n ? facing<A>(n, x, dir) : 0);
+            // The voxels whose step leaves the leaf: without a neighbour in the domain they
+            // have none.
+            Word leaving;
+            if constexpr (A == 0)
+                leaving = x + dir >= 0 && x + dir < 8 ? 0 : ~Word(0);
+            else if constexpr (A == 1)
+                leaving = dir > 0 ? kY7 : kY0;
+            else
+                leaving = dir > 0 ? kZ7 : kZ0;
+            valid[x] = n ? ~Word(0) : ~leaving;
         }
     }
 

@@ -52,21 +52,9 @@ void writeBlock(std::size_t bytes) {
     std::memset(sink, 1, bytes);
 }
 
-// AddressSanitizer replaces the allocator, and glibc's settings with it.
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitized = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitized = true;
-#else
-constexpr bool kSanitized = false;
-#endif
-#else
-constexpr bool kSanitized = false;
-#endif
-
 TEST(Memory, FreedMemoryIsKeptForTheNextAllocation) {
-    if (kSanitized) GTEST_SKIP() << "AddressSanitizer's allocator does not take glibc's settings";
+    if (kAddressSanitizer)
+        GTEST_SKIP() << "AddressSanitizer's allocator does not take glibc's settings";
     keepFreedMemory();
     constexpr std::size_t kBytes = std::size_t(24) << 20, kPages = kBytes / 4096;
     writeBlock(kBytes);

@@ -1,0 +1,39 @@
+// A leaf's voxel sets as eight 64-bit words, one per x: bit y * 8 + z of word x is the voxel
+// at offset x * 64 + y * 8 + z (the layout of a leaf's value mask). The scans of the band
+// (voxels next to the surface, seeds, thin features) test 64 voxels at a time by moving a
+// set one step along an axis; that step is written once, here.
+#pragma once
+
+#include <cstdint>
+
+namespace sweepers::leafwords {
+
+using Word = std::uint64_t;
+constexpr Word kZ0 = 0x0101010101010101ull, kZ7 = kZ0 << 7; // the voxels at z = 0, z = 7
+constexpr Word kY0 = 0xffull, kY7 = kY0 << 56;              // the voxels at y = 0, y = 7
+
+// Word x of the set `own` seen one step along axis A (dir = +-1): its bit for a voxel is the
+// bit of the voxel one step away. Past the leaf's face it reads `facing`, the layer of the
+// next leaf that faces it, laid out as that axis needs it: along x the whole word, along y
+// the row of eight bits (bits 0-7), along z one bit a row (bit y * 8).
+template <int A> Word stepped(const Word* own, int x, int dir, Word facing) {
+    if constexpr (A == 2)
+        return dir > 0 ? ((own[x] >> 1) & ~kZ7) | (facing << 7) : ((own[x] << 1) & ~kZ0) | facing;
+    else if constexpr (A == 1)
+        return dir > 0 ? (own[x] >> 8) | (facing << 56) : (own[x] << 8) | facing;
+    else
+        return x + dir >= 0 && x + dir < 8 ? own[x + dir] : facing;
+}
+
+// The layer of the set `next` (the leaf one step along axis A, dir = +-1) that faces this
+// leaf, for word x, laid out as stepped<A> reads it.
+template <int A> Word facing(const Word* next, int x, int dir) {
+    if constexpr (A == 2)
+        return dir > 0 ? next[x] & kZ0 : (next[x] & kZ7) >> 7;
+    else if constexpr (A == 1)
+        return dir > 0 ? next[x] & kY0 : next[x] >> 56;
+    else
+        return next[dir > 0 ? 0 : 7];
+}
+
+} // namespace sweepers::leafwords
