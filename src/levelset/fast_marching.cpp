@@ -186,30 +186,6 @@ Bits inBox(const openvdb::CoordBBox& box, const openvdb::Coord& origin) {
     return out;
 }
 
-// The voxels of the face neighbour along `axis` (dir = +-1) of a leaf that lie within
-// `reach` steps of its voxels `bits`, in the neighbour's own offsets.
-Bits across(const Bits& bits, int axis, int dir, int reach) {
-    constexpr std::uint64_t z0 = 0x0101010101010101ull;
-    Bits out{};
-    for (int d = 1; d <= reach; ++d)
-        for (int t = 0; t < d; ++t) {
-            // The neighbour's layer `to` lies d steps from this leaf's layer `from`.
-            const int from = dir > 0 ? 8 - d + t : d - 1 - t;
-            const int to = dir > 0 ? t : 7 - t;
-            for (int x = 0; x < 8; ++x) {
-                if (axis == 0) {
-                    if (x == to) out[std::size_t(x)] |= bits[std::size_t(from)];
-                } else if (axis == 1) {
-                    out[std::size_t(x)] |= ((bits[std::size_t(x)] >> (8 * from)) & 0xffull)
-                                           << (8 * to);
-                } else {
-                    out[std::size_t(x)] |= ((bits[std::size_t(x)] >> from) & z0) << to;
-                }
-            }
-        }
-    return out;
-}
-
 bool negative(float v) {
     return v < 0.0f;
 }
@@ -219,11 +195,15 @@ bool negative(float v) {
 // the first-order difference, 9/4 for the second-order one). Solved for w = u - m_0, where
 // every term is of the order of h^2, so single precision keeps the root to about 1e-7 h.
 float solveUpwind(float m[3], float c[3], int n, float h) {
+    // Compare and swap by selects: the order of the values is random, so branches on it
+    // would be mispredicted half the time.
     const auto order = [&](int i, int j) {
-        if (m[j] < m[i]) {
-            std::swap(m[i], m[j]);
-            std::swap(c[i], c[j]);
-        }
+        const bool swap = m[j] < m[i];
+        const float mi = m[i], mj = m[j], ci = c[i], cj = c[j];
+        m[i] = swap ? mj : mi;
+        m[j] = swap ? mi : mj;
+        c[i] = swap ? cj : ci;
+        c[j] = swap ? ci : cj;
     };
     if (n > 1) order(0, 1);
     if (n > 2) {
@@ -231,7 +211,8 @@ float solveUpwind(float m[3], float c[3], int n, float h) {
         order(0, 1);
     }
     if (m[0] == kInf) return kInf; // no neighbour of its side has a value
-    float w = h / std::sqrt(c[0]);
+    // h / sqrt(c_0) without the root: c_0 is 1 or 9/4, whose root is 3/2 exactly.
+    float w = c[0] == 1.0f ? h : h / 1.5f;
     // sum_k c_k (w - d_k)^2 - h^2 = A w^2 - 2 B w + C, with d_k = m_k - m_0.
     float A = c[0], B = 0.0f, C = -h * h;
     for (int k = 1; k < n; ++k) {
@@ -492,16 +473,26 @@ class Renormalizer {
     void load(std::size_t l, int rim, Block& block) const {
         constexpr int R = Block::kRim, X = Block::kStride[0], Y = Block::kStride[1];
         // Voxel `off` of a leaf whose distances start at d and whose inside voxels are `inside`.
+        // (Selects, not stores through a side index: they compile without branches.)
         const auto put = [&](const float* d, const Bits& inside, int off, int b) {
             const bool in = isSet(inside, off);
-            block.side[in][std::size_t(b)] = d[off];
-            block.side[!in][std::size_t(b)] = kInf;
+            const float v = d[off];
+            block.side[1][std::size_t(b)] = in ? v : kInf;
+            block.side[0][std::size_t(b)] = in ? kInf : v;
         };
+        const float* own = &dist_[l << 9];
         for (int x = 0; x < 8; ++x)
             for (int y = 0; y < 8; ++y) {
-                const int b = (x + R) * X + (y + R) * Y + R;
-                for (int z = 0; z < 8; ++z)
-                    put(&dist_[l << 9], neg_[l], x * 64 + y * 8 + z, b + z);
+                const std::size_t b = std::size_t((x + R) * X + (y + R) * Y + R);
+                const unsigned row = unsigned(neg_[l][std::size_t(x)] >> (8 * y)) & 0xffu;
+                const float* d = own + x * 64 + y * 8;
+                float* in = &block.side[1][b];
+                float* out = &block.side[0][b];
+                for (int z = 0; z < 8; ++z) {
+                    const bool inside = (row >> z) & 1u;
+                    in[z] = inside ? d[z] : kInf;
+                    out[z] = inside ? kInf : d[z];
+                }
             }
         for (int k = 0; k < 6; ++k) {
             const int axis = k / 2;
@@ -625,11 +616,11 @@ class Renormalizer {
                                     inbox[l * 8 + std::size_t(x)] |= left[x];
                                     pending[l] = true;
                                 }
+                            handOn(l, changed, w.block, reach, inbox.get(), pending.get());
                             forEachBit(changed, [&](int off) {
                                 dist_[(l << 9) + std::size_t(off)] =
                                     w.block.side[isSet(neg_[l], off)][std::size_t(Block::at(off))];
                             });
-                            handOn(l, changed, reach, inbox.get(), pending.get());
                         }
                     });
             }
@@ -722,17 +713,50 @@ class Renormalizer {
         return changed;
     }
 
-    // Hands the voxels of l's neighbours within `reach` steps of `changed` to their inboxes.
-    void handOn(std::size_t l, const Bits& changed, int reach, std::atomic<std::uint64_t>* inbox,
-                std::atomic<bool>* pending) const {
+    // Hands to l's neighbours the voxels whose stencils may read a voxel of l that changed:
+    // those of its side within `reach` steps along an axis (with no voxel of the other side
+    // between), whose values lie above the changed voxel's old or new value. A stencil only
+    // reads neighbours below the value it solves for, so the others would solve to what they
+    // hold. Called before the changed values are written back (dist_ holds the old ones);
+    // the neighbours are of another class, so nothing writes them meanwhile.
+    void handOn(std::size_t l, const Bits& changed, const Block& block, int reach,
+                std::atomic<std::uint64_t>* inbox, std::atomic<bool>* pending) const {
+        std::array<Bits, 6> into{};
+        forEachBit(changed, [&](int off) {
+            const bool side = isSet(neg_[l], off);
+            const float low = std::min(block.side[side][std::size_t(Block::at(off))],
+                                       dist_[(l << 9) + std::size_t(off)]);
+            forEachAxis([&](auto a) {
+                constexpr int shift = 6 - 3 * decltype(a)::value;
+                const int pos = (off >> shift) & 7;
+                for (const int dir : {-1, 1}) {
+                    if (dir > 0 ? pos < 8 - reach : pos >= reach) continue;
+                    const int k = 2 * decltype(a)::value + (dir > 0);
+                    const int nl = b_.neighbourLeaf(l, k);
+                    if (nl < 0) continue;
+                    for (int step = 1; step <= reach; ++step) {
+                        const int c = pos + dir * step;
+                        const int rest = off & ~(7 << shift);
+                        if (c >= 0 && c < 8) {
+                            if (isSet(neg_[l], rest | c << shift) != side) break;
+                            continue;
+                        }
+                        const int n = rest | (c - 8 * dir) << shift;
+                        if (isSet(neg_[std::size_t(nl)], n) != side) break;
+                        if (dist_[(std::size_t(nl) << 9) + std::size_t(n)] > low)
+                            set(into[std::size_t(k)], n);
+                    }
+                }
+            });
+        });
         for (int k = 0; k < 6; ++k) {
             const int nl = b_.neighbourLeaf(l, k);
             if (nl < 0) continue;
-            const Bits into = across(changed, k / 2, k % 2 ? 1 : -1, reach);
             bool any = false;
             for (int x = 0; x < 8; ++x)
-                if (into[x]) {
-                    inbox[std::size_t(nl) * 8 + std::size_t(x)] |= into[x];
+                if (into[std::size_t(k)][std::size_t(x)]) {
+                    inbox[std::size_t(nl) * 8 + std::size_t(x)] |=
+                        into[std::size_t(k)][std::size_t(x)];
                     any = true;
                 }
             if (any) pending[nl] = true;
