@@ -4,7 +4,10 @@
 #include <array>
 #include <cstdint>
 #include <stdexcept>
-#include <unordered_map>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 namespace sweepers {
 
@@ -14,73 +17,183 @@ using Leaf = openvdb::MaskTree::LeafNodeType;
 constexpr int kDim = int(Leaf::DIM); // 8
 // A leaf's mask as eight words, one per x; bit y * 8 + z of word x is voxel (x, y, z).
 using Bits = std::array<std::uint64_t, kDim>;
-using Leaves = std::unordered_map<openvdb::Coord, Bits>;
+using Word = std::uint64_t;
 
-Bits& at(Leaves& leaves, const openvdb::Coord& origin) {
-    return leaves.try_emplace(origin, Bits{}).first->second;
+struct MaskLeaf {
+    openvdb::Coord at; // the leaf's position in leaves (origin / 8)
+    Bits bits;
+};
+
+// Per byte of a word (a row along z), the bits of z below s, and of z at 8 - s and above.
+constexpr Word lowBits(int s) {
+    return 0x0101010101010101ull * ((Word(1) << s) - 1);
+}
+constexpr Word highBits(int s) {
+    return lowBits(s) << (kDim - s);
 }
 
-// Dilation along z: within each row of eight bits, spilling into the leaves before and after.
-Leaves dilateZ(const Leaves& in, int r) {
-    Leaves out;
-    for (const auto& [origin, bits] : in) {
-        Bits& own = at(out, origin);
-        Bits* before = nullptr;
-        Bits* after = nullptr;
-        for (int x = 0; x < kDim; ++x)
-            for (int y = 0; y < kDim; ++y) {
-                const std::uint32_t row = std::uint32_t(bits[x] >> (8 * y)) & 0xffu;
-                if (!row) continue;
-                // The row in the middle of 24 bits: the leaf before, this one, the one after.
-                std::uint32_t wide = row << 8;
-                for (int s = 1; s <= r; ++s)
-                    wide |= (row << (8 + s)) | (row << (8 - s));
-                own[x] |= std::uint64_t((wide >> 8) & 0xffu) << (8 * y);
-                if (wide & 0xffu) {
-                    if (!before) before = &at(out, origin.offsetBy(0, 0, -kDim));
-                    (*before)[x] |= std::uint64_t(wide & 0xffu) << (8 * y);
-                }
-                if (wide >> 16) {
-                    if (!after) after = &at(out, origin.offsetBy(0, 0, kDim));
-                    (*after)[x] |= std::uint64_t(wide >> 16) << (8 * y);
-                }
+// Unit u (a row of word x along y, or word u along x) of a leaf.
+template <int Axis> Word unitOf(const Bits& b, int x, int u) {
+    return Axis == 1 ? (b[std::size_t(x)] >> (8 * u)) & 0xffu : b[std::size_t(u)];
+}
+
+// The voxels of a leaf within r (1..8) steps along Axis (0 = x, 1 = y, 2 = z) of its own
+// voxels `own`, of its neighbour before it `before` and after it `after` (null: none).
+template <int Axis>
+Bits dilatedAlong(const Bits& own, const Bits* before, const Bits* after, int r) {
+    Bits out{};
+    if constexpr (Axis == 2) {
+        // Rows of eight bits in each byte: shifted within the byte, and in from the ends of
+        // the rows of the leaves before and after.
+        for (std::size_t x = 0; x < kDim; ++x) {
+            Word w = own[x];
+            for (int s = 1; s <= r; ++s) {
+                w |= ((own[x] << s) & ~lowBits(s)) | ((own[x] >> s) & ~highBits(s));
+                if (before) w |= (((*before)[x] >> (kDim - s)) & lowBits(s));
+                if (after) w |= (((*after)[x] << (kDim - s)) & highBits(s));
             }
-    }
-    return out;
-}
-
-// Dilation along y (rows of a word) or x (words of a leaf): unit u of the leaf spreads to
-// units u - r ... u + r, those past either end landing in the neighbouring leaf.
-template <int Axis> Leaves dilateRows(const Leaves& in, int r) {
-    Leaves out;
-    const auto unit = [](const Bits& b, int x, int u) -> std::uint64_t {
-        return Axis == 1 ? (b[x] >> (8 * u)) & 0xffu : b[u];
-    };
-    const auto merge = [](Bits& b, int x, int u, std::uint64_t v) {
-        if (Axis == 1)
-            b[x] |= v << (8 * u);
-        else
-            b[u] |= v;
-    };
-    for (const auto& [origin, bits] : in) {
-        Bits* leaf[3] = {nullptr, &at(out, origin), nullptr};
-        // For rows (y) every word x is its own line; for words (x) there is one line.
+            out[x] = w;
+        }
+    } else {
+        // Units u - r ... u + r of this leaf and those past its ends in the neighbours.
+        const auto unitAt = [&](int x, int t) -> Word {
+            if (t < 0) return before ? unitOf<Axis>(*before, x, t + kDim) : 0;
+            if (t >= kDim) return after ? unitOf<Axis>(*after, x, t - kDim) : 0;
+            return unitOf<Axis>(own, x, t);
+        };
         for (int x = 0; x < (Axis == 1 ? kDim : 1); ++x)
             for (int u = 0; u < kDim; ++u) {
-                const std::uint64_t v = unit(bits, x, u);
-                if (!v) continue;
-                for (int t = u - r; t <= u + r; ++t) {
-                    const int side = t < 0 ? 0 : (t < kDim ? 1 : 2);
-                    if (!leaf[side]) {
-                        openvdb::Coord o = origin;
-                        o[Axis] += side == 0 ? -kDim : kDim;
-                        leaf[side] = &at(out, o);
-                    }
-                    merge(*leaf[side], x, t - (side - 1) * kDim, v);
-                }
+                Word v = 0;
+                for (int t = u - r; t <= u + r; ++t)
+                    v |= unitAt(x, t);
+                if (Axis == 1)
+                    out[std::size_t(x)] |= v << (8 * u);
+                else
+                    out[std::size_t(u)] = v;
             }
     }
     return out;
+}
+
+// Whether a leaf reaches into its neighbour along Axis on side dir (+-1) when dilated by r.
+template <int Axis> bool spills(const Bits& b, int dir, int r) {
+    for (int x = 0; x < kDim; ++x)
+        for (int t = 0; t < r; ++t) {
+            const int u = dir > 0 ? kDim - 1 - t : t; // the units within r of that face
+            if (Axis == 2) {
+                if (b[std::size_t(x)] & (0x0101010101010101ull << u)) return true;
+            } else if (unitOf<Axis>(b, x, u)) {
+                return true;
+            }
+        }
+    return false;
+}
+
+// The leaves of a box, every slot holding the index of its leaf in a list or -1: the
+// neighbour of a leaf is an array read, not a hash lookup.
+class LeafBox {
+  public:
+    LeafBox(const openvdb::Coord& lo, const openvdb::Coord& hi)
+        : lo_(lo), n_(hi - lo + openvdb::Coord(1)),
+          index_(std::size_t(n_.x()) * std::size_t(n_.y()) * std::size_t(n_.z()), -1) {}
+    // The list index of the leaf at position c (-1: none, or outside the box).
+    int& at(const openvdb::Coord& c) { return index_[slot(c)]; }
+    int get(const openvdb::Coord& c) const {
+        const openvdb::Coord d = c - lo_;
+        if (d.x() < 0 || d.y() < 0 || d.z() < 0 || d.x() >= n_.x() || d.y() >= n_.y() ||
+            d.z() >= n_.z())
+            return -1;
+        return index_[slot(c)];
+    }
+
+  private:
+    std::size_t slot(const openvdb::Coord& c) const {
+        const openvdb::Coord d = c - lo_;
+        return (std::size_t(d.x()) * std::size_t(n_.y()) + std::size_t(d.y())) *
+                   std::size_t(n_.z()) +
+               std::size_t(d.z());
+    }
+    openvdb::Coord lo_, n_;
+    std::vector<int> index_;
+};
+
+// One dilation by r (1..8) along Axis of every leaf of the list, the list growing by the
+// neighbours it reaches into. Each leaf's result is read from itself and its two neighbours
+// along the axis, so the leaves are done in parallel.
+template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box, int r) {
+    const std::size_t count = leaves.size();
+    for (std::size_t i = 0; i < count; ++i)
+        for (const int dir : {-1, 1}) {
+            openvdb::Coord c = leaves[i].at;
+            c[Axis] += dir;
+            if (box.at(c) >= 0 || !spills<Axis>(leaves[i].bits, dir, r)) continue;
+            box.at(c) = int(leaves.size());
+            leaves.push_back({c, Bits{}});
+        }
+    std::vector<Bits> out(leaves.size());
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, leaves.size(), 64), [&](const auto& range) {
+            for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                openvdb::Coord c = leaves[i].at;
+                c[Axis] -= 1;
+                const int b = box.get(c);
+                c[Axis] += 2;
+                const int a = box.get(c);
+                out[i] = dilatedAlong<Axis>(leaves[i].bits,
+                                            b < 0 ? nullptr : &leaves[std::size_t(b)].bits,
+                                            a < 0 ? nullptr : &leaves[std::size_t(a)].bits, r);
+            }
+        });
+    for (std::size_t i = 0; i < leaves.size(); ++i)
+        leaves[i].bits = out[i];
+}
+
+// A box of leaves may hold this many slots per leaf of the mask (plus a few thousand) before
+// the mask is split: a brush's band fills a few percent of its box.
+constexpr std::size_t kSlotsPerLeaf = 64, kFewSlots = 1 << 15;
+
+// Dilates the leaves of [begin, end) by the cube of half-side `radius` into `tree`. The cube
+// distributes over a union, so a mask whose leaves are far apart is split in two along its
+// longest side, and each half is dilated in its own box.
+void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::iterator end,
+                int radius, openvdb::MaskTree& tree) {
+    const int reach = (radius + kDim - 1) / kDim; // in leaves
+    openvdb::Coord lo = begin->at, hi = begin->at;
+    for (auto it = begin; it != end; ++it) {
+        lo.minComponent(it->at);
+        hi.maxComponent(it->at);
+    }
+    lo -= openvdb::Coord(reach);
+    hi += openvdb::Coord(reach);
+    const openvdb::Coord n = hi - lo + openvdb::Coord(1);
+    const double slots = double(n.x()) * n.y() * n.z();
+    const std::size_t count = std::size_t(end - begin);
+    if (count > 1 && slots > double(kSlotsPerLeaf * count + kFewSlots)) {
+        const int axis = int(n.maxIndex());
+        const auto middle = begin + std::ptrdiff_t(count / 2);
+        std::nth_element(begin, middle, end, [axis](const MaskLeaf& a, const MaskLeaf& b) {
+            return a.at[axis] < b.at[axis];
+        });
+        dilateInto(begin, middle, radius, tree);
+        dilateInto(middle, end, radius, tree);
+        return;
+    }
+    std::vector<MaskLeaf> leaves(begin, end);
+    LeafBox box(lo, hi);
+    for (std::size_t i = 0; i < leaves.size(); ++i)
+        box.at(leaves[i].at) = int(i);
+    // Cubes add up: past a leaf's width, dilate one leaf's width at a time.
+    for (int left = radius; left > 0; left -= kDim) {
+        const int r = std::min(left, kDim);
+        dilateList<2>(leaves, box, r);
+        dilateList<1>(leaves, box, r);
+        dilateList<0>(leaves, box, r);
+    }
+    for (const MaskLeaf& leaf : leaves) {
+        Leaf* node = tree.touchLeaf(leaf.at << Leaf::LOG2DIM);
+        for (int x = 0; x < kDim; ++x)
+            node->getValueMask().getWord<Word>(x) |= leaf.bits[std::size_t(x)];
+    }
 }
 
 } // namespace
@@ -88,22 +201,15 @@ template <int Axis> Leaves dilateRows(const Leaves& in, int r) {
 void dilateByCube(openvdb::MaskTree& tree, int radius) {
     if (radius < 0) throw std::invalid_argument("dilateByCube: a negative radius");
     if (radius == 0) return;
-    Leaves leaves;
+    std::vector<MaskLeaf> leaves;
+    leaves.reserve(tree.leafCount());
     for (auto it = tree.cbeginLeaf(); it; ++it) {
-        Bits& b = leaves[it->origin()];
+        MaskLeaf leaf{it->origin() >> Leaf::LOG2DIM, Bits{}};
         for (int x = 0; x < kDim; ++x)
-            b[x] = it->getValueMask().getWord<std::uint64_t>(x);
+            leaf.bits[std::size_t(x)] = it->getValueMask().getWord<Word>(x);
+        leaves.push_back(leaf);
     }
-    // Cubes add up: past a leaf's width, dilate one leaf's width at a time.
-    for (int left = radius; left > 0; left -= kDim) {
-        const int r = std::min(left, kDim);
-        leaves = dilateRows<0>(dilateRows<1>(dilateZ(leaves, r), r), r);
-    }
-    for (const auto& [origin, bits] : leaves) {
-        Leaf* leaf = tree.touchLeaf(origin);
-        for (int x = 0; x < kDim; ++x)
-            leaf->getValueMask().getWord<std::uint64_t>(x) |= bits[x];
-    }
+    if (!leaves.empty()) dilateInto(leaves.begin(), leaves.end(), radius, tree);
 }
 
 } // namespace sweepers

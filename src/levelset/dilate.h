@@ -3,7 +3,9 @@
 //
 // A sculpting segment dilates two brush-sized masks by the band's half-width. The cube is
 // separable, so it is done as three one-dimensional dilations on the 64-bit words of the
-// leaf masks, rather than `radius` rounds over all 26 neighbours.
+// leaf masks, rather than `radius` rounds over all 26 neighbours. The leaves are indexed by
+// their place in a box of leaves, so each one reads its neighbours by an array lookup, and
+// they are dilated in parallel.
 #pragma once
 
 #include <openvdb/openvdb.h>

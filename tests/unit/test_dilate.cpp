@@ -46,6 +46,28 @@ TEST(DilateByCube, EqualsRepeatedTwentySixNeighbourDilation) {
         }
 }
 
+// Clusters far apart: one box of leaves around all of them would hold some 10^12 slots, so
+// the mask is split until each part's box is dense enough; the cube distributes over the
+// union.
+TEST(DilateByCube, FarApartClustersAreDilatedEachInItsOwnBox) {
+    const auto mask = randomMask(4);
+    for (const openvdb::Coord shift :
+         {openvdb::Coord(100000, 0, 0), openvdb::Coord(0, -90000, 40000), openvdb::Coord(3000)}) {
+        const auto far = randomMask(5 + unsigned(shift.x() & 7));
+        for (auto it = far->cbeginValueOn(); it; ++it)
+            mask->setValueOn(it.getCoord() + shift);
+    }
+    for (int radius : {3, 11}) {
+        auto dilated = std::make_shared<openvdb::MaskTree>(*mask);
+        auto expected = std::make_shared<openvdb::MaskTree>(*mask);
+        openvdb::tools::dilateActiveValues(*expected, radius, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                           openvdb::tools::IGNORE_TILES);
+        dilateByCube(*dilated, radius);
+        EXPECT_EQ(dilated->activeVoxelCount(), expected->activeVoxelCount()) << radius;
+        EXPECT_TRUE(dilated->hasSameTopology(*expected)) << radius;
+    }
+}
+
 TEST(DilateByCube, RefusesANegativeRadius) {
     openvdb::MaskTree tree;
     tree.setValueOn(openvdb::Coord(0));
