@@ -5,8 +5,10 @@
 #include "levelset/local_tree.h"
 #include "levelset/monotone_cubic.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -175,7 +177,9 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
                      const StepDeformation* tearing, double tornWindow, Sampling sampling,
                      openvdb::MaskGrid& changed, Interrupter* interrupter) {
-    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> marks;
+    // Per leaf, the voxels whose value changed (a word per x, as the leaf's mask holds them):
+    // written by the leaf's own task, then merged into `changed` a leaf at a time.
+    std::vector<std::array<std::uint64_t, 8>> changedWords(leaves.size());
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
     tbb::enumerable_thread_specific<SourceBlock> blocks;
@@ -218,17 +222,21 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                     }
                 }
                 if (v != *it || !(before ? before->isValueOn(it.pos()) : acc.isValueOn(ijk)))
-                    marks.local().push_back(ijk);
+                    changedWords[l][it.pos() >> 6] |= std::uint64_t(1) << (it.pos() & 63);
                 it.setValue(v);
                 ++n;
             }
         }
         count += n;
     });
-    auto macc = changed.getAccessor();
-    for (const auto& m : marks)
-        for (const openvdb::Coord& c : m)
-            macc.setValueOn(c);
+    for (std::size_t l = 0; l < leaves.size(); ++l) {
+        const auto& words = changedWords[l];
+        if (std::all_of(words.begin(), words.end(), [](std::uint64_t w) { return w == 0; }))
+            continue;
+        auto& mask = changed.tree().touchLeaf(leaves[l]->origin())->getValueMask();
+        for (int x = 0; x < 8; ++x)
+            mask.getWord<std::uint64_t>(x) |= words[std::size_t(x)];
+    }
     return count;
 }
 
@@ -430,10 +438,22 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                     options.interrupter);
         widened = source;
     }
-    // Voxels the band grows into: renormalized (or dropped again) wherever they are.
-    openvdb::MaskGrid::Ptr fresh = mask->deepCopy();
-    fresh->tree().topologyDifference(grid.tree());
-    grid.tree().topologyUnion(mask->tree());
+    // Voxels the band grows into (renormalized, or dropped again, wherever they are): the
+    // mask's voxels not yet on in the grid, found and switched on a leaf and a word at a time.
+    openvdb::MaskGrid::Ptr fresh = openvdb::MaskGrid::create();
+    for (auto it = mask->tree().cbeginLeaf(); it; ++it) {
+        if (it->isEmpty()) continue;
+        auto& on = grid.tree().touchLeaf(it->origin())->getValueMask();
+        openvdb::MaskTree::LeafNodeType* grown = nullptr;
+        for (int x = 0; x < 8; ++x) {
+            const std::uint64_t add = it->getValueMask().getWord<std::uint64_t>(x);
+            if (const std::uint64_t newlyOn = add & ~on.getWord<std::uint64_t>(x)) {
+                if (!grown) grown = fresh->tree().touchLeaf(it->origin());
+                grown->getValueMask().getWord<std::uint64_t>(x) = newlyOn;
+            }
+            on.getWord<std::uint64_t>(x) |= add;
+        }
+    }
     stats.growSeconds = secondsSince(t0);
 
     // 2. Sample: composed inverse (default) or one resample per sub-step (5.3.4).
