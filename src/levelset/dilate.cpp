@@ -190,7 +190,9 @@ void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
         dilateList<0>(leaves, box, r);
     }
     for (const MaskLeaf& leaf : leaves) {
-        Leaf* node = tree.touchLeaf(leaf.at << Leaf::LOG2DIM);
+        // (Multiplied, not shifted: a left shift of a negative coordinate is undefined.)
+        Leaf* node = tree.touchLeaf(
+            openvdb::Coord(leaf.at.x() * kDim, leaf.at.y() * kDim, leaf.at.z() * kDim));
         for (int x = 0; x < kDim; ++x)
             node->getValueMask().getWord<Word>(x) |= leaf.bits[std::size_t(x)];
     }
