@@ -9,6 +9,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "levelset/leaf_words.h"
+
 namespace sweepers {
 
 namespace {
@@ -16,8 +18,9 @@ namespace {
 using Leaf = openvdb::MaskTree::LeafNodeType;
 constexpr int kDim = int(Leaf::DIM); // 8
 // A leaf's mask as eight words, one per x; bit y * 8 + z of word x is voxel (x, y, z).
-using Bits = std::array<std::uint64_t, kDim>;
-using Word = std::uint64_t;
+using leafwords::kZ0;
+using leafwords::Word;
+using Bits = std::array<Word, kDim>;
 
 struct MaskLeaf {
     openvdb::Coord at; // the leaf's position in leaves (origin / 8)
@@ -26,7 +29,7 @@ struct MaskLeaf {
 
 // Per byte of a word (a row along z), the bits of z below s, and of z at 8 - s and above.
 constexpr Word lowBits(int s) {
-    return 0x0101010101010101ull * ((Word(1) << s) - 1);
+    return kZ0 * ((Word(1) << s) - 1);
 }
 constexpr Word highBits(int s) {
     return lowBits(s) << (kDim - s);
@@ -81,7 +84,7 @@ template <int Axis> bool spills(const Bits& b, int dir, int r) {
         for (int t = 0; t < r; ++t) {
             const int u = dir > 0 ? kDim - 1 - t : t; // the units within r of that face
             if (Axis == 2) {
-                if (b[std::size_t(x)] & (0x0101010101010101ull << u)) return true;
+                if (b[std::size_t(x)] & (kZ0 << u)) return true;
             } else if (unitOf<Axis>(b, x, u)) {
                 return true;
             }
