@@ -19,6 +19,7 @@
 
 #include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
+#include "levelset/value_order.h"
 
 namespace sweepers {
 
@@ -230,17 +231,6 @@ float solveUpwind(float m[3], float c[3], int n, float h) {
     return m[0] + w;
 }
 
-// A value with its leaf offset below it: non-negative floats order as their bits do, so
-// one integer comparison orders entries by value, then by offset.
-using Entry = std::uint64_t;
-Entry entry(float v, int off) {
-    std::uint32_t bits;
-    std::memcpy(&bits, &v, sizeof bits);
-    return (Entry(bits) << 32) | Entry(std::uint32_t(off));
-}
-int offsetOf(Entry e) {
-    return int(e & 0xffffffffu);
-}
 // One leaf of the domain and a rim of two voxels taken from its six face neighbours, in a
 // dense block: the upwind stencils (which reach two voxels along each axis) read their
 // neighbours by fixed strides, without branching on leaf borders. Each side of the surface
@@ -269,7 +259,7 @@ constexpr int kMostPasses = 16, kMostRounds = 100;
 // What one thread needs to solve a leaf.
 struct LeafWork {
     Block block;
-    std::vector<Entry> order; // of a pass
+    std::vector<ValueEntry> order, scratch; // of a pass, and its sort's
 };
 
 class Renormalizer {
@@ -640,24 +630,24 @@ class Renormalizer {
                 Bits& left) const {
         const Bits &inside = neg_[l], &settled = settled_[l];
         const float tolerance = kSolveTolerance * h_;
-        std::vector<Entry>& order = w.order;
+        std::vector<ValueEntry>& order = w.order;
         order.clear();
         for (int x = 0; x < 8; ++x)
             for (std::uint64_t bits = ~settled[std::size_t(x)]; bits; bits &= bits - 1) {
                 const int off = x * 64 + __builtin_ctzll(bits);
                 const float u = w.block.side[isSet(inside, off)][std::size_t(Block::at(off))];
-                if ((first && u < kInf) || isSet(handed, off)) order.push_back(entry(u, off));
+                if ((first && u < kInf) || isSet(handed, off)) order.push_back(valueEntry(u, off));
             }
         Bits changed{};
         Bits valued = sources_[l]; // voxels with a value, whose neighbours may get one
         for (int pass = 0; !order.empty() && pass < kMostPasses; ++pass) {
-            std::sort(order.begin(), order.end());
+            sortByValue(order, w.scratch, bg_);
             Bits queued{}, done{}, again{};
             float front = 0.0f; // the largest value solved in this pass
-            for (const Entry e : order)
-                set(queued, offsetOf(e));
-            for (const Entry e : order) {
-                const int off = offsetOf(e);
+            for (const ValueEntry e : order)
+                set(queued, entryOffset(e));
+            for (const ValueEntry e : order) {
+                const int off = entryOffset(e);
                 const bool side = isSet(inside, off);
                 float* v = w.block.side[side].data();
                 const int b = Block::at(off);
@@ -704,12 +694,12 @@ class Renormalizer {
             order.clear();
             forEachBit(again, [&](int off) {
                 order.push_back(
-                    entry(w.block.side[isSet(inside, off)][std::size_t(Block::at(off))], off));
+                    valueEntry(w.block.side[isSet(inside, off)][std::size_t(Block::at(off))], off));
             });
         }
         left = Bits{};
-        for (const Entry e : order)
-            set(left, offsetOf(e));
+        for (const ValueEntry e : order)
+            set(left, entryOffset(e));
         return changed;
     }
 
