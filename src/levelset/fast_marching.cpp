@@ -278,15 +278,17 @@ class Renormalizer {
             float* dist = &dist_[l << 9];
             std::memcpy(phi, values, sizeof(float) * kLeafVoxels);
             std::memset(&thin_[l << 9], 0, kLeafVoxels);
+            // Free voxels start from their own values (their order is nearly right). Two loops,
+            // so that this one is vectorized.
+            for (int i = 0; i < kLeafVoxels; ++i) {
+                const float a = std::abs(phi[i]);
+                dist[i] = a < bg_ ? a : kInf;
+            }
             Bits& neg = neg_[l];
             for (int x = 0; x < 8; ++x) {
                 std::uint64_t word = 0;
-                for (int k = 0; k < 64; ++k) {
-                    const float p = phi[x * 64 + k];
-                    // Free voxels start from their own values (their order is nearly right).
-                    dist[x * 64 + k] = std::abs(p) < bg_ ? std::abs(p) : kInf;
-                    word |= std::uint64_t(negative(p)) << k;
-                }
+                for (int k = 0; k < 64; ++k)
+                    word |= std::uint64_t(negative(phi[x * 64 + k])) << k;
                 neg[std::size_t(x)] = word;
             }
             Bits free = inBox(region, leaf.origin());
@@ -473,9 +475,9 @@ class Renormalizer {
         const float* own = &dist_[l << 9];
         for (int x = 0; x < 8; ++x)
             for (int y = 0; y < 8; ++y) {
-                const std::size_t b = std::size_t((x + R) * X + (y + R) * Y + R);
+                const auto b = std::size_t((x + R) * X) + std::size_t((y + R) * Y + R);
                 const unsigned row = unsigned(neg_[l][std::size_t(x)] >> (8 * y)) & 0xffu;
-                const float* d = own + x * 64 + y * 8;
+                const float* d = own + std::size_t(x) * 64 + std::size_t(y) * 8;
                 float* in = &block.side[1][b];
                 float* out = &block.side[0][b];
                 for (int z = 0; z < 8; ++z) {
@@ -759,18 +761,27 @@ class Renormalizer {
     std::size_t writeBack() {
         tbb::enumerable_thread_specific<std::size_t> solved(0);
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
+            // Only the free voxels, straight into the leaf's buffer and its mask a word at a
+            // time (most of a domain is boundary; a setValueOn per voxel checked whether the
+            // buffer was in memory every time).
             Leaf& leaf = b_.leaf(l);
+            float* values = leaf.buffer().data();
+            auto& mask = leaf.getValueMask();
+            const float* dist = &dist_[l << 9];
             std::size_t n = 0;
-            for (int off = 0; off < kLeafVoxels; ++off) {
-                const std::size_t i = (l << 9) + off;
-                if (isSet(fixed_[l], off)) continue;
-                const bool neg = isSet(neg_[l], off);
-                if (dist_[i] < bg_) {
-                    leaf.setValueOn(off, neg ? -dist_[i] : dist_[i]);
-                    n += !isSet(settled_[l], off);
-                } else {
-                    leaf.setValueOff(off, neg ? -bg_ : bg_);
+            for (int x = 0; x < 8; ++x) {
+                std::uint64_t on = mask.getWord<std::uint64_t>(x);
+                const std::uint64_t inside = neg_[l][std::size_t(x)];
+                for (std::uint64_t bits = ~fixed_[l][std::size_t(x)]; bits; bits &= bits - 1) {
+                    const int k = __builtin_ctzll(bits), off = x * 64 + k;
+                    const std::uint64_t bit = std::uint64_t(1) << k;
+                    const bool band = dist[off] < bg_;
+                    const float d = band ? dist[off] : bg_;
+                    values[off] = inside & bit ? -d : d;
+                    on = band ? on | bit : on & ~bit;
+                    n += band && !(settled_[l][std::size_t(x)] & bit);
                 }
+                mask.getWord<std::uint64_t>(x) = on;
             }
             solved.local() += n;
         });
