@@ -113,10 +113,16 @@ class LeafVertices {
     std::uint32_t generation_ = 0;
 };
 
-MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
-    MeshChunk chunk;
+// Meshes the leaf at `origin` into `chunk`, whose vectors keep their storage: re-meshing a
+// segment's leaves allocates nothing once their chunks have grown.
+void meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) {
+    chunk.positions.clear();
+    chunk.normals.clear();
+    chunk.edgeKeys.clear();
+    chunk.triangles.clear();
+    chunk.volume = 0.0;
     const Grid::TreeType::LeafNodeType* leaf = grid.tree().probeConstLeaf(origin);
-    if (!leaf) return chunk;
+    if (!leaf) return;
     const LeafBlock acc(grid.getConstAccessor(), *leaf);
     const auto& xform = grid.transform();
     const double h = grid.voxelSize()[0];
@@ -190,23 +196,25 @@ MeshChunk meshLeaf(const Grid& grid, const openvdb::Coord& origin) {
             chunk.triangles.emplace_back(ids[0], ids[1], ids[2]);
         }
     }
-    return chunk;
+    chunk.volume = enclosedVolume(chunk.positions, chunk.triangles);
 }
 
 } // namespace
 
 void SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
                                Interrupter* interrupter) {
-    std::vector<MeshChunk> out(origins.size());
+    // Each leaf into its chunk (made where there is none; a map's elements stay where they
+    // are, so the chunks are written in parallel); chunks left without a triangle go.
+    std::vector<MeshChunk*> into(origins.size());
+    for (std::size_t i = 0; i < origins.size(); ++i)
+        into[i] = &chunks_[origins[i]];
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
         pollInterrupt(interrupter);
         for (std::size_t i = r.begin(); i != r.end(); ++i)
-            out[i] = meshLeaf(grid, origins[i]);
+            meshLeaf(grid, origins[i], *into[i]);
     });
-    for (std::size_t i = 0; i < origins.size(); ++i) {
-        if (out[i].triangles.empty()) continue;
-        chunks_[origins[i]] = std::move(out[i]);
-    }
+    for (std::size_t i = 0; i < origins.size(); ++i)
+        if (into[i]->triangles.empty()) chunks_.erase(origins[i]);
 }
 
 MeshChanges SurfaceMesher::takeChanges() {
@@ -228,14 +236,17 @@ std::size_t SurfaceMesher::update(const Grid& grid, const openvdb::CoordBBox& to
     openvdb::CoordBBox box = touched;
     box.expand(1);
     changes_.box.expand(box);
-    // Forget every chunk whose leaf overlaps the box (they are keyed by leaf origin: visit
-    // the box leaf by leaf), then mesh the leaves there now.
+    // Forget the chunks of the box whose leaves are gone (chunks are keyed by leaf origin,
+    // in x, y, z order: one row of them at a time), then mesh the leaves there now into
+    // the chunks they had.
     constexpr int kDim = int(LeafNode::DIM);
     const openvdb::Coord first = floorToMultiple(box.min(), kDim);
     for (int x = first.x(); x <= box.max().x(); x += kDim)
         for (int y = first.y(); y <= box.max().y(); y += kDim)
-            for (int z = first.z(); z <= box.max().z(); z += kDim)
-                chunks_.erase(openvdb::Coord(x, y, z));
+            for (auto it = chunks_.lower_bound(openvdb::Coord(x, y, first.z()));
+                 it != chunks_.end() && it->first.x() == x && it->first.y() == y &&
+                 it->first.z() <= box.max().z();)
+                it = grid.tree().probeConstLeaf(it->first) ? std::next(it) : chunks_.erase(it);
     std::vector<openvdb::Coord> origins;
     for (const LeafNode* leaf : leavesIn(std::as_const(grid.tree()), box))
         origins.push_back(leaf->origin());
@@ -253,7 +264,7 @@ std::size_t SurfaceMesher::triangleCount() const {
 double SurfaceMesher::enclosedVolume() const {
     double v = 0.0;
     for (const auto& [o, c] : chunks_)
-        v += sweepers::enclosedVolume(c.positions, c.triangles);
+        v += c.volume;
     return v;
 }
 

@@ -22,6 +22,7 @@ struct MeshChunk {
     std::vector<Eigen::Vector3f> positions, normals;
     std::vector<std::uint64_t> edgeKeys; // one per vertex
     std::vector<Eigen::Vector3i> triangles;
+    double volume = 0.0; // the enclosedVolume of its triangles (their part of the whole)
 };
 
 // What changed in a mesher since it was last asked: everything, or the chunks whose
@@ -44,7 +45,8 @@ class SurfaceMesher {
     MeshChanges takeChanges();
     std::size_t triangleCount() const;
     // Enclosed volume of the chunks' triangles (a shared edge vertex has the same
-    // coordinates in both chunks, so no welding is needed).
+    // coordinates in both chunks, so no welding is needed): the sum of the volumes each
+    // chunk keeps, so asking after every segment costs an addition per chunk.
     double enclosedVolume() const;
     // One mesh with the chunks welded along their shared edges.
     TriangleMesh weld() const;

@@ -153,3 +153,35 @@ TEST(MarchingCubes, IncrementalUpdateMatchesRebuild) {
     EXPECT_NEAR(incremental.enclosedVolume(), enclosedVolume(y), 1e-9);
     EXPECT_TRUE(meshTopology(x).watertight());
 }
+
+// Re-meshed chunks reuse their storage: after a dent pushed in and pulled out again, the
+// incremental mesher holds chunk for chunk what a rebuild holds (none missing, and none
+// left without a triangle where the surface left a leaf of the band), and its volume is the
+// rebuild's to the bit.
+TEST(MarchingCubes, UpdatedChunksAreThoseOfARebuild) {
+    const double h = 1.0 / 32;
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+    SurfaceMesher incremental;
+    incremental.rebuild(*g);
+    Placement a, b;
+    a.t = {0, 1.25, 0};
+    b.t = {0.05, 0.75, 0};
+    for (const Sweep& sweep : {Sweep{{{std::make_shared<EllipsoidShape>(0.3), 0.3, {a, b}}}},
+                               Sweep{{{std::make_shared<EllipsoidShape>(0.3), 0.3, {b, a}}}}}) {
+        const AdvectStats stats = advectSegment(*g, SweepSegment(sweep, 0));
+        incremental.update(*g, stats.touched);
+        SurfaceMesher full;
+        full.rebuild(*g);
+        ASSERT_EQ(incremental.chunks().size(), full.chunks().size());
+        for (const auto& [origin, chunk] : full.chunks()) {
+            const auto it = incremental.chunks().find(origin);
+            ASSERT_NE(it, incremental.chunks().end()) << origin;
+            EXPECT_EQ(it->second.triangles, chunk.triangles) << origin;
+            EXPECT_EQ(it->second.positions, chunk.positions) << origin;
+            EXPECT_EQ(it->second.volume, chunk.volume) << origin;
+        }
+        EXPECT_EQ(incremental.enclosedVolume(), full.enclosedVolume());
+        for (const auto& [origin, chunk] : incremental.chunks())
+            EXPECT_FALSE(chunk.triangles.empty()) << origin;
+    }
+}
