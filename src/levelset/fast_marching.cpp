@@ -453,12 +453,14 @@ class Renormalizer {
         return count.combine(std::plus<>());
     }
 
-    // Which of eight classes leaf l belongs to, by the parity of its position along each
-    // axis: leaves of one class never share a face, and a block reads only its leaf and
-    // the faces of its neighbours, so the leaves of a class are solved in parallel.
+    // Which of two classes leaf l belongs to, by the parity of the sum of its position (a
+    // checkerboard): leaves of one class never share a face, and a block reads only its leaf
+    // and the faces of its neighbours, so the leaves of a class are solved in parallel. (The
+    // eight classes of the parities along each axis waited at eight barriers a round where
+    // two do; the renormalization of a drag segment took 7% longer.)
     int classOf(std::size_t l) const {
         const openvdb::Coord o = b_.leaf(l).origin() >> Leaf::LOG2DIM;
-        return (o.x() & 1) | (o.y() & 1) << 1 | (o.z() & 1) << 2;
+        return (o.x() + o.y() + o.z()) & 1;
     }
 
     // Copies leaf l and `rim` layers of its face neighbours (1 or 2) into the block.
@@ -554,7 +556,7 @@ class Renormalizer {
     void solve() {
         const std::size_t leaves = b_.leafCount();
         const int reach = order_ == FmmOrder::Second ? 2 : 1; // how far a stencil reads
-        std::array<std::vector<std::size_t>, 8> classes;
+        std::array<std::vector<std::size_t>, 2> classes;
         for (std::size_t l = 0; l < leaves; ++l)
             classes[std::size_t(classOf(l))].push_back(l);
         // Per leaf: the voxels handed in by its neighbours (a word per x, as Bits), and
