@@ -342,10 +342,14 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                 const LeafNode& leaf = *leaves[l];
                 leafStill[l] = still(leaf);
                 const bool whole = region.isInside(leaf.getNodeBoundingBox());
-                const auto crossing = crossingVoxels(leaf, acc);
-                for (auto it = leaf.cbeginValueOn(); it; ++it)
-                    if (crossing.isOn(it.pos()) && (whole || region.isInside(it.getCoord())))
-                        found[l].push_back(it.getCoord());
+                // The active voxels next to the crossing, a word of the masks at a time (a
+                // leaf's 300 or so active voxels hold some 40 of them).
+                auto crossing = crossingVoxels(leaf, acc);
+                crossing &= leaf.getValueMask();
+                for (auto it = crossing.beginOn(); it; ++it) {
+                    const openvdb::Coord ijk = leaf.offsetToGlobalCoord(it.pos());
+                    if (whole || region.isInside(ijk)) found[l].push_back(ijk);
+                }
             }
         });
         for (std::size_t l = 0; l < leaves.size(); ++l) {
