@@ -203,18 +203,27 @@ void meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) 
 
 void SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
                                Interrupter* interrupter) {
-    // Each leaf into its chunk (made where there is none; a map's elements stay where they
-    // are, so the chunks are written in parallel); chunks left without a triangle go.
+    // Each leaf into the chunk it has (its storage reused) or into a new one, which joins
+    // the map only when it holds a triangle (a map's elements stay where they are, so the
+    // chunks are written in parallel); chunks left without a triangle go.
     std::vector<MeshChunk*> into(origins.size());
-    for (std::size_t i = 0; i < origins.size(); ++i)
-        into[i] = &chunks_[origins[i]];
+    std::vector<MeshChunk> fresh(origins.size());
+    for (std::size_t i = 0; i < origins.size(); ++i) {
+        const auto it = chunks_.find(origins[i]);
+        into[i] = it == chunks_.end() ? &fresh[i] : &it->second;
+    }
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
         pollInterrupt(interrupter);
         for (std::size_t i = r.begin(); i != r.end(); ++i)
             meshLeaf(grid, origins[i], *into[i]);
     });
-    for (std::size_t i = 0; i < origins.size(); ++i)
-        if (into[i]->triangles.empty()) chunks_.erase(origins[i]);
+    for (std::size_t i = 0; i < origins.size(); ++i) {
+        if (into[i] == &fresh[i]) {
+            if (!fresh[i].triangles.empty()) chunks_.emplace(origins[i], std::move(fresh[i]));
+        } else if (into[i]->triangles.empty()) {
+            chunks_.erase(origins[i]);
+        }
+    }
 }
 
 MeshChanges SurfaceMesher::takeChanges() {
