@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 #include <openvdb/tools/LevelSetMeasure.h>
+#include <tbb/global_control.h>
 
 #include "grids.h"
 #include "levelset/band.h"
@@ -242,5 +243,37 @@ TEST(FastMarching, VoxelsAreSortedByValueThenOffset) {
         std::sort(expected.begin(), expected.end());
         sortByValue(entries, scratch, bound);
         ASSERT_EQ(entries, expected) << "trial " << trial;
+    }
+}
+
+// The leaves of one class are solved at once, so no two of them may share a face (a leaf
+// reads its face neighbours' values): the result is then the same on one thread as on two,
+// to the bit, however the threads share the leaves.
+TEST(FastMarching, OneThreadAndTwoGiveTheSameBand) {
+    const double h = 1.0 / 48;
+    auto sdf = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
+    GridPtr g = gridFromSdf(sdf, h, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90));
+    distort(*g);
+    GridPtr one = g->deepCopy();
+    {
+        const tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
+        renormalizeAll(*one);
+    }
+    for (int run = 0; run < 3; ++run) {
+        GridPtr two = g->deepCopy();
+        {
+            const tbb::global_control pair(tbb::global_control::max_allowed_parallelism, 2);
+            renormalizeAll(*two);
+        }
+        std::size_t differ = 0;
+        for (auto leaf = one->tree().cbeginLeaf(); leaf; ++leaf) {
+            const LeafNode* other = two->tree().probeConstLeaf(leaf->origin());
+            ASSERT_NE(other, nullptr) << leaf->origin();
+            for (openvdb::Index i = 0; i < LeafNode::SIZE; ++i)
+                differ += leaf->getValue(i) != other->getValue(i) ||
+                          leaf->isValueOn(i) != other->isValueOn(i);
+        }
+        EXPECT_EQ(one->tree().leafCount(), two->tree().leafCount());
+        EXPECT_EQ(differ, 0u) << "run " << run;
     }
 }
