@@ -319,8 +319,9 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     //    (the stretch), which bounds how far a pre-image can sit from the old surface.
     auto t0 = Clock::now();
     // Leaves where the deformation is the identity (within a voxel of them: the stretch
-    // reads half a voxel around an image) keep their values; their interface voxels are
-    // their own images.
+    // reads half a voxel around an image) keep their values, and the band already covers
+    // their surface: only the interface of the other leaves is forward-mapped (the images
+    // of a moving leaf's surface reach into still leaves where they need a band).
     const auto still = [&](const LeafNode& leaf) {
         openvdb::CoordBBox box = leaf.getNodeBoundingBox();
         box.expand(1);
@@ -328,19 +329,18 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         return seg.identityOn(Box(toEigen(world.min()), toEigen(world.max())));
     };
     std::vector<openvdb::Coord> interface;
-    std::vector<bool> interfaceStill;
     {
         // Found leaf by leaf in parallel, then listed in leaf order (the stretch samples
         // every fourth one of that list).
         const auto leaves = leavesIn(std::as_const(grid.tree()), region);
-        stats.leavesVisited += leaves.size();
         std::vector<std::vector<openvdb::Coord>> found(leaves.size());
-        std::vector<char> leafStill(leaves.size());
+        std::vector<char> scanned(leaves.size(), 0);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
             const auto acc = grid.getConstAccessor();
             for (std::size_t l = r.begin(); l != r.end(); ++l) {
                 const LeafNode& leaf = *leaves[l];
-                leafStill[l] = still(leaf);
+                if (still(leaf)) continue;
+                scanned[l] = 1;
                 const bool whole = region.isInside(leaf.getNodeBoundingBox());
                 // The active voxels next to the crossing, a word of the masks at a time (a
                 // leaf's 300 or so active voxels hold some 40 of them).
@@ -353,9 +353,10 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             }
         });
         for (std::size_t l = 0; l < leaves.size(); ++l) {
+            if (!scanned[l]) continue;
+            ++stats.leavesVisited;
             stats.voxelsVisited += leaves[l]->onVoxelCount();
             interface.insert(interface.end(), found[l].begin(), found[l].end());
-            interfaceStill.insert(interfaceStill.end(), found[l].size(), leafStill[l] != 0);
         }
     }
     stats.interfaceVoxels = interface.size();
@@ -367,10 +368,6 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         Marks& m = marks.local();
         double& worst = stretch.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            if (interfaceStill[i]) {
-                m.push_back(interface[i]);
-                continue;
-            }
             Eigen::Vector3d p = toEigen(grid.indexToWorld(interface[i]));
             for (int k = 0; k < seg.steps(); ++k) {
                 p = seg.forwardStep(k, p, forwardTolerance).p;
