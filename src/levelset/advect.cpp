@@ -486,9 +486,9 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         stats.leavesCopied += moving.size();
         return copy;
     };
-    // Voxels inside the region that are not in the band kept their old inactive values,
-    // whose signs may now be wrong (space pulled out of the shape is inside it now):
-    // re-derive the inactive signs there (and in the band grown around it) from the band.
+    // Inactive voxels of the resampled leaves kept their old values, whose signs may now be
+    // wrong (space pulled out of the shape is inside it now): their signs, and those of the
+    // tiles around them, are re-derived from the band. Other leaves did not change.
     const openvdb::CoordBBox touched = changedRegion(grid, seg);
     const double tornWindow = (std::ceil(halfWidth) + 1) * h; // see resample
     if (!options.resampleEachSubStep) {
@@ -502,7 +502,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         // signs are re-derived before it reads them: otherwise a pre-image beyond the band
         // takes the sign its place had before the earlier sub-steps moved the surface.
         for (int k = 0; k < seg.steps(); ++k) {
-            if (k > 0) stats.leavesFlooded += floodSignsIn(grid.tree(), touched);
+            if (k > 0) stats.leavesFlooded += floodSignsIn(grid.tree(), moving, touched);
             stats.sampledVoxels += resample(
                 grid, moving, *source(k), !widened || k > 0, region,
                 [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); },
@@ -511,7 +511,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         }
     }
     stats.voxelsVisited += stats.sampledVoxels;
-    stats.leavesFlooded += floodSignsIn(grid.tree(), touched);
+    stats.leavesFlooded += floodSignsIn(grid.tree(), moving, touched);
     stats.sampleSeconds = secondsSince(t0);
 
     // 3. Renormalize the changed region (and the band around it).

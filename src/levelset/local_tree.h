@@ -77,15 +77,16 @@ void copyBox(const openvdb::CoordBBox& box, float* out, const LeafAt& leafAt,
             }
 }
 
-// Re-derives the signs of the inactive values in the leaves and internal nodes that
-// overlap `box` (what tools::signedFloodFill does to a whole tree), from their active
-// values; everything outside keeps its values. Returns the number of leaves filled.
-inline std::size_t floodSignsIn(Grid::TreeType& tree, const openvdb::CoordBBox& box) {
+// Re-derives the signs of the inactive values of `leaves` and of the internal nodes that
+// overlap `box` (what tools::signedFloodFill does to a whole tree), from their active values;
+// everything else keeps its values (a leaf whose values did not change keeps its signs).
+// Returns the number of leaves filled.
+inline std::size_t floodSignsIn(Grid::TreeType& tree, const std::vector<LeafNode*>& leaves,
+                                const openvdb::CoordBBox& box) {
     if (box.empty()) return 0;
     const openvdb::tools::SignedFloodFillOp<Grid::TreeType> fill(tree);
     // Leaves only read their own values, so they are filled in parallel; a node's tiles take
     // their signs from its children, so nodes are filled after them, bottom up.
-    const std::vector<LeafNode*> leaves = leavesIn(tree, box);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
         for (std::size_t l = r.begin(); l != r.end(); ++l)
             fill(*leaves[l]);
