@@ -239,6 +239,50 @@ TEST(Advect, ASegmentsWorkFollowsTheBrushNotTheModel) {
     EXPECT_EQ(differing, 0u);
 }
 
+TEST(Advect, ShapesWhereTheDeformationIsTheIdentityCostNoWork) {
+    // One pull on the unit sphere, alone and with a small sphere in a corner of the
+    // segment's affected box, outside the tool's coating: the small sphere's surface is not
+    // forward-mapped, sampled, copied or flooded, and it keeps its values.
+    const double h = 1.0 / 128;
+    const GridPtr alone = makeSphere({0, 0, 0}, 1.0, h, 3.0);
+    GridPtr both = alone->deepCopy();
+    const Eigen::Vector3d corner(0.42, 1.4, 0.42);
+    openvdb::tools::csgUnion(both->tree(), makeSphere(corner, 0.05, h, 3.0)->tree());
+    const Sweep sweep{
+        {{std::make_shared<EllipsoidShape>(0.25), 0.25, {at({0, 0.95, 0}), at({0, 0.98, 0})}}}};
+    const SweepSegment segment(sweep, 0);
+    // The small sphere's band lies in the box whose leaves the segment looks at, away from
+    // the coating (radius 0.5 around the tool's path).
+    const Box affected = segment.affectedBox();
+    ASSERT_TRUE(affected.contains(corner + Eigen::Vector3d::Constant(0.05 + 3 * h)));
+    const GridPtr small = makeSphere(corner, 0.05, h, 3.0);
+    const GridPtr before = both->deepCopy();
+    const AdvectStats a = advectSegment(*alone, segment), b = advectSegment(*both, segment);
+    std::printf("[ still ] interface %zu, sampled %zu, copied %zu, flooded %zu, voxels "
+                "visited %zu alone; %zu, %zu, %zu, %zu, %zu with the small sphere\n",
+                a.interfaceVoxels, a.sampledVoxels, a.leavesCopied, a.leavesFlooded,
+                a.voxelsVisited, b.interfaceVoxels, b.sampledVoxels, b.leavesCopied,
+                b.leavesFlooded, b.voxelsVisited);
+    EXPECT_GT(a.interfaceVoxels, 0u);
+    EXPECT_EQ(a.interfaceVoxels, b.interfaceVoxels);
+    EXPECT_EQ(a.sampledVoxels, b.sampledVoxels);
+    EXPECT_EQ(a.leavesCopied, b.leavesCopied);
+    EXPECT_EQ(a.leavesFlooded, b.leavesFlooded);
+    // The small sphere's leaves hold what they held, active states included.
+    std::size_t leaves = 0, differing = 0;
+    for (auto it = small->tree().cbeginLeaf(); it; ++it) {
+        const LeafNode* was = before->tree().probeConstLeaf(it->origin());
+        const LeafNode* now = both->tree().probeConstLeaf(it->origin());
+        ASSERT_TRUE(was && now);
+        ++leaves;
+        differing += was->getValueMask() != now->getValueMask();
+        for (openvdb::Index i = 0; i < LeafNode::SIZE; ++i)
+            differing += was->getValue(i) != now->getValue(i);
+    }
+    EXPECT_GT(leaves, 0u);
+    EXPECT_EQ(differing, 0u);
+}
+
 // A segment renormalizes only where its samples changed values or the band grew, and as far
 // as the band reaches from there. That must be everywhere renormalizing could change
 // anything: the same segments renormalized over their whole boxes give the same grid. (The
