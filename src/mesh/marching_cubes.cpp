@@ -2,10 +2,13 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
+#include <optional>
 #include <utility>
 
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
+#include <xxhash.h>
 
 #include "levelset/local_tree.h"
 #include "levelset/stencils.h"
@@ -50,6 +53,32 @@ class LeafBlock {
     float getValue(const openvdb::Coord& c) const {
         const openvdb::Coord l = c - origin_;
         return values_[((l.x() + 1) * kSpan + l.y() + 1) * kSpan + l.z() + 1];
+    }
+
+    // Whether all the cubes' corners (the leaf and one voxel past its upper faces) lie on
+    // one side of the surface: then none of its cubes crosses it.
+    bool oneSign() const {
+        bool any = false, all = true;
+        for (int x = 1; x <= kDim + 1; ++x)
+            for (int y = 1; y <= kDim + 1; ++y) {
+                const float* row = &values_[std::size_t((x * kSpan + y) * kSpan + 1)];
+                for (int z = 0; z <= kDim; ++z) {
+                    any |= row[z] < 0.0f;
+                    all &= row[z] < 0.0f;
+                }
+            }
+        return any == all;
+    }
+
+    // A hash of the values, the leaf's active voxels and where the grid puts its voxels:
+    // what meshing the leaf reads (never 0, which marks a chunk made from nothing).
+    std::uint64_t fingerprint(const LeafNode& leaf, const openvdb::math::Transform& xform) const {
+        const openvdb::Vec3d placement[2] = {xform.indexToWorld(openvdb::Vec3d(0.0)),
+                                             xform.voxelSize()};
+        std::uint64_t seed = XXH3_64bits(placement, sizeof(placement));
+        const auto& mask = leaf.getValueMask();
+        seed = XXH3_64bits_withSeed(&mask, sizeof(mask), seed);
+        return XXH3_64bits_withSeed(values_.data(), sizeof(values_), seed) | 1;
     }
 
   private:
@@ -115,15 +144,25 @@ class LeafVertices {
 
 // Meshes the leaf at `origin` into `chunk`, whose vectors keep their storage: re-meshing a
 // segment's leaves allocates nothing once their chunks have grown.
-void meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) {
+// Returns whether it meshed it (not when the chunk was made from the same values).
+bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) {
+    const Grid::TreeType::LeafNodeType* leaf = grid.tree().probeConstLeaf(origin);
+    std::optional<LeafBlock> block;
+    if (leaf) block.emplace(grid.getConstAccessor(), *leaf);
+    if (!leaf || block->oneSign()) { // no surface
+        const bool had = chunk.madeFrom != 0;
+        chunk = MeshChunk{};
+        return had;
+    }
+    const std::uint64_t madeFrom = block->fingerprint(*leaf, grid.transform());
+    if (madeFrom == chunk.madeFrom) return false; // the same triangles again
     chunk.positions.clear();
     chunk.normals.clear();
     chunk.edgeKeys.clear();
     chunk.triangles.clear();
     chunk.volume = 0.0;
-    const Grid::TreeType::LeafNodeType* leaf = grid.tree().probeConstLeaf(origin);
-    if (!leaf) return;
-    const LeafBlock acc(grid.getConstAccessor(), *leaf);
+    chunk.madeFrom = madeFrom;
+    const LeafBlock& acc = *block;
     const auto& xform = grid.transform();
     const double h = grid.voxelSize()[0];
     thread_local LeafVertices vertices;
@@ -197,12 +236,13 @@ void meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) 
         }
     }
     chunk.volume = enclosedVolume(chunk.positions, chunk.triangles);
+    return true;
 }
 
 } // namespace
 
-void SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
-                               Interrupter* interrupter) {
+std::size_t SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
+                                      Interrupter* interrupter) {
     // Each leaf into the chunk it has (its storage reused) or into a new one, which joins
     // the map only when it holds a triangle (a map's elements stay where they are, so the
     // chunks are written in parallel); chunks left without a triangle go.
@@ -212,10 +252,13 @@ void SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coor
         const auto it = chunks_.find(origins[i]);
         into[i] = it == chunks_.end() ? &fresh[i] : &it->second;
     }
+    std::atomic<std::size_t> meshed{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
         pollInterrupt(interrupter);
+        std::size_t n = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i)
-            meshLeaf(grid, origins[i], *into[i]);
+            n += meshLeaf(grid, origins[i], *into[i]);
+        meshed += n;
     });
     for (std::size_t i = 0; i < origins.size(); ++i) {
         if (into[i] == &fresh[i]) {
@@ -224,6 +267,7 @@ void SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coor
             chunks_.erase(origins[i]);
         }
     }
+    return meshed;
 }
 
 MeshChanges SurfaceMesher::takeChanges() {
@@ -242,8 +286,10 @@ void SurfaceMesher::rebuild(const Grid& grid, Interrupter* interrupter) {
 }
 
 std::size_t SurfaceMesher::update(const Grid& grid, const openvdb::CoordBBox& touched) {
+    // A leaf's cubes read one voxel past its upper faces, and their normals one more, and
+    // one before its lower faces.
     openvdb::CoordBBox box = touched;
-    box.expand(1);
+    box.expand(2);
     changes_.box.expand(box);
     // Forget the chunks of the box whose leaves are gone (chunks are keyed by leaf origin,
     // in x, y, z order: one row of them at a time), then mesh the leaves there now into
@@ -259,8 +305,7 @@ std::size_t SurfaceMesher::update(const Grid& grid, const openvdb::CoordBBox& to
     std::vector<openvdb::Coord> origins;
     for (const LeafNode* leaf : leavesIn(std::as_const(grid.tree()), box))
         origins.push_back(leaf->origin());
-    meshLeaves(grid, origins);
-    return origins.size();
+    return meshLeaves(grid, origins);
 }
 
 std::size_t SurfaceMesher::triangleCount() const {

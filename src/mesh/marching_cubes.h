@@ -23,6 +23,10 @@ struct MeshChunk {
     std::vector<std::uint64_t> edgeKeys; // one per vertex
     std::vector<Eigen::Vector3i> triangles;
     double volume = 0.0; // the enclosedVolume of its triangles (their part of the whole)
+    // A hash of everything the triangles were made from (the values the leaf's cubes and
+    // normals read, its active voxels, the voxel size; 0: none): a leaf whose hash is
+    // unchanged is not meshed again.
+    std::uint64_t madeFrom = 0;
 };
 
 // What changed in a mesher since it was last asked: everything, or the chunks whose
@@ -37,7 +41,8 @@ class SurfaceMesher {
   public:
     // Meshes every active leaf; a cancelled rebuild (Cancelled) changes nothing.
     void rebuild(const Grid& grid, Interrupter* interrupter = nullptr);
-    // Re-meshes the leaves overlapping `touched` grown by one voxel; returns how many.
+    // Re-meshes the leaves overlapping `touched` grown by one voxel whose values changed;
+    // returns how many were meshed.
     std::size_t update(const Grid& grid, const openvdb::CoordBBox& touched);
 
     const std::map<openvdb::Coord, MeshChunk>& chunks() const { return chunks_; }
@@ -52,8 +57,10 @@ class SurfaceMesher {
     TriangleMesh weld() const;
 
   private:
-    void meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
-                    Interrupter* interrupter = nullptr);
+    // Returns how many leaves were meshed (those with a chunk made from other values, and
+    // those without one).
+    std::size_t meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
+                           Interrupter* interrupter = nullptr);
     std::map<openvdb::Coord, MeshChunk> chunks_;
     MeshChanges changes_{true, {}};
 };

@@ -168,3 +168,42 @@ TEST(MarchingCubes, IncrementalUpdateMatchesRebuild) {
             EXPECT_FALSE(chunk.triangles.empty()) << origin;
     }
 }
+
+TEST(MarchingCubes, ALeafIsMeshedAgainExactlyWhenWhatItReadsChanged) {
+    // One value at a time is moved (its sign kept) around a leaf with surface: inside it, on
+    // the layers past its faces that its cubes read, and two past its upper faces and one
+    // before its lower ones, which its normals read. The update of that voxel alone must
+    // give the rebuilt mesh, normals included; updating where nothing changed meshes
+    // nothing.
+    const double h = 1.0 / 16;
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+    SurfaceMesher incremental;
+    incremental.rebuild(*g);
+    const openvdb::Coord origin = incremental.chunks().begin()->first;
+    const openvdb::CoordBBox around(origin.offsetBy(-2), origin.offsetBy(LeafNode::DIM + 2));
+    EXPECT_EQ(incremental.update(*g, around), 0u);
+    auto acc = g->getAccessor();
+    std::size_t moved = 0;
+    for (const int x : {-1, 0, 4, 7, 8, 9})
+        for (const int y : {-1, 0, 4, 7, 8, 9})
+            for (const int z : {-1, 0, 4, 7, 8, 9}) {
+                const openvdb::Coord c = origin.offsetBy(x, y, z);
+                const float was = acc.getValue(c);
+                if (!acc.isValueOn(c)) continue; // the band's values only
+                acc.setValue(c, 0.7f * was);
+                incremental.update(*g, openvdb::CoordBBox(c, c));
+                SurfaceMesher full;
+                full.rebuild(*g);
+                const auto it = incremental.chunks().find(origin);
+                const auto want = full.chunks().find(origin);
+                ASSERT_NE(it, incremental.chunks().end());
+                ASSERT_NE(want, full.chunks().end());
+                EXPECT_EQ(it->second.positions, want->second.positions) << c;
+                EXPECT_EQ(it->second.normals, want->second.normals) << c;
+                EXPECT_EQ(it->second.triangles, want->second.triangles) << c;
+                acc.setValue(c, was);
+                incremental.update(*g, openvdb::CoordBBox(c, c));
+                ++moved;
+            }
+    EXPECT_GT(moved, 40u);
+}
