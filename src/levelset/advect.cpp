@@ -27,6 +27,16 @@ namespace {
 // interface voxel in four finds its maximum to within the margin the widening adds.
 constexpr std::size_t kStretchSampling = 4;
 
+// Trilinear interpolation of a cell's corner values at offset uvw inside it, in single
+// precision (the values are floats; OpenVDB's BoxSampler turns every product into a double
+// and back, which made this a twelfth of a drag segment).
+float trilinearIn(const float (&c)[2][2][2], const openvdb::Vec3d& uvw) {
+    const float u = float(uvw[0]), v = float(uvw[1]), w = float(uvw[2]);
+    const auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
+    return lerp(lerp(lerp(c[0][0][0], c[0][0][1], w), lerp(c[0][1][0], c[0][1][1], w), v),
+                lerp(lerp(c[1][0][0], c[1][0][1], w), lerp(c[1][1][0], c[1][1][1], w), v), u);
+}
+
 // What sampling reads: the grid as it was before sampling began. Sampling writes only the
 // leaves it resamples, so those are copied first (copy on write) and every other read goes
 // to the live grid, which nothing else changes meanwhile: the cost follows the brush, not
@@ -67,7 +77,7 @@ class SampleSource {
             return live_.probeValue(ijk, v);
         }
 
-        // Trilinear interpolation at index-space point p (OpenVDB's BoxSampler, to the bit).
+        // Trilinear interpolation at index-space point p.
         // When the cell lies inside one leaf (343 cells in 512) its eight corners are read
         // from that leaf's buffer, after a single lookup instead of eight.
         float trilinear(const openvdb::Vec3d& p) const {
@@ -92,7 +102,7 @@ class SampleSource {
                         for (int k = 0; k < 2; ++k)
                             data[i][j][k] = getValue(ijk.offsetBy(i, j, k));
             }
-            return openvdb::tools::BoxSampler::trilinearInterpolation(data, uvw);
+            return trilinearIn(data, uvw);
         }
 
         // The source leaf holding ijk (a copy, or the live grid's), or null over a tile.
@@ -143,7 +153,7 @@ class SourceBlock {
             for (std::size_t j = 0; j < 2; ++j)
                 for (std::size_t k = 0; k < 2; ++k)
                     data[i][j][k] = values_[o + i * kDim * kDim + j * kDim + k];
-        return openvdb::tools::BoxSampler::trilinearInterpolation(data, uvw);
+        return trilinearIn(data, uvw);
     }
 
   private:
