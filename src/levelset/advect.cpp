@@ -53,8 +53,12 @@ class SampleSource {
     template <typename Leaves> static GridPtr copyLeaves(const Grid& live, const Leaves& leaves) {
         GridPtr copies = Grid::create(live.background());
         copies->setTransform(live.transform().copy());
-        for (const LeafNode* leaf : leaves)
-            copies->tree().addLeaf(new LeafNode(*leaf));
+        // Copied in parallel, then put in the tree (which is not safe to grow in parallel).
+        std::vector<LeafNode*> made(leaves.size());
+        tbb::parallel_for(std::size_t(0), leaves.size(),
+                          [&](std::size_t i) { made[i] = new LeafNode(*leaves[i]); });
+        for (LeafNode* leaf : made)
+            copies->tree().addLeaf(leaf);
         return copies;
     }
 
@@ -370,12 +374,12 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         }
     }
     stats.interfaceVoxels = interface.size();
-    using Marks = std::vector<openvdb::Coord>;
-    tbb::enumerable_thread_specific<Marks> marks;
+    // Each thread marks the images in a mask of its own; the masks are merged after.
+    tbb::enumerable_thread_specific<openvdb::MaskTree> marks;
     tbb::enumerable_thread_specific<double> stretch(1.0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
         pollInterrupt(options.interrupter);
-        Marks& m = marks.local();
+        openvdb::tree::ValueAccessor<openvdb::MaskTree, false> m(marks.local());
         double& worst = stretch.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             Eigen::Vector3d p = toEigen(grid.indexToWorld(interface[i]));
@@ -383,7 +387,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                 p = seg.forwardStep(k, p, forwardTolerance).p;
                 // Intermediate surfaces only need a band when they are stored.
                 if (options.resampleEachSubStep || k + 1 == seg.steps())
-                    m.push_back(openvdb::Coord::round(grid.worldToIndex(toVdb(p))));
+                    m.setValueOn(openvdb::Coord::round(grid.worldToIndex(toVdb(p))));
             }
             if (i % kStretchSampling != 0) continue;
             // How far the inverse map can spread a voxel-sized neighbourhood of the new
@@ -403,12 +407,8 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     });
     openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create();
     mask->setTransform(grid.transform().copy());
-    {
-        auto macc = mask->getAccessor();
-        for (const Marks& m : marks)
-            for (const openvdb::Coord& c : m)
-                macc.setValueOn(c);
-    }
+    for (const openvdb::MaskTree& m : marks)
+        mask->tree().topologyUnion(m);
     const int dilation = int(std::ceil(halfWidth)) + 1;
     dilateByCube(mask->tree(), dilation);
     // A tear opens empty space where there was material: no image of the surface reaches
@@ -451,18 +451,24 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     }
     // Voxels the band grows into (renormalized, or dropped again, wherever they are): the
     // mask's voxels not yet on in the grid, found and switched on a leaf and a word at a time.
+    // (Through accessors: the mask's leaves come in the tree's order, so most lie in the
+    // internal node of the one before.)
     openvdb::MaskGrid::Ptr fresh = openvdb::MaskGrid::create();
-    for (auto it = mask->tree().cbeginLeaf(); it; ++it) {
-        if (it->isEmpty()) continue;
-        auto& on = grid.tree().touchLeaf(it->origin())->getValueMask();
-        openvdb::MaskTree::LeafNodeType* grown = nullptr;
-        for (int x = 0; x < 8; ++x) {
-            const std::uint64_t add = it->getValueMask().getWord<std::uint64_t>(x);
-            if (const std::uint64_t newlyOn = add & ~on.getWord<std::uint64_t>(x)) {
-                if (!grown) grown = fresh->tree().touchLeaf(it->origin());
-                grown->getValueMask().getWord<std::uint64_t>(x) = newlyOn;
+    {
+        auto into = grid.getAccessor();
+        auto freshAcc = fresh->getAccessor();
+        for (auto it = mask->tree().cbeginLeaf(); it; ++it) {
+            if (it->isEmpty()) continue;
+            auto& on = into.touchLeaf(it->origin())->getValueMask();
+            openvdb::MaskTree::LeafNodeType* grown = nullptr;
+            for (int x = 0; x < 8; ++x) {
+                const std::uint64_t add = it->getValueMask().getWord<std::uint64_t>(x);
+                if (const std::uint64_t newlyOn = add & ~on.getWord<std::uint64_t>(x)) {
+                    if (!grown) grown = freshAcc.touchLeaf(it->origin());
+                    grown->getValueMask().getWord<std::uint64_t>(x) = newlyOn;
+                }
+                on.getWord<std::uint64_t>(x) |= add;
             }
-            on.getWord<std::uint64_t>(x) |= add;
         }
     }
     stats.growSeconds = secondsSince(t0);

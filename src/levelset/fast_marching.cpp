@@ -9,7 +9,6 @@
 #include <limits>
 #include <memory>
 #include <type_traits>
-#include <unordered_map>
 #include <vector>
 
 #include <openvdb/tools/Prune.h>
@@ -52,19 +51,24 @@ class Domain {
         openvdb::CoordBBox outer = region;
         outer.expand(margin);
         leaves_ = leavesIn(grid.tree(), outer);
-        std::unordered_map<openvdb::Coord, int> index;
-        index.reserve(leaves_.size());
+        // The leaves by origin, where each leaf's neighbours are looked up (in parallel).
+        std::vector<std::pair<openvdb::Coord, int>> index(leaves_.size());
         for (std::size_t l = 0; l < leaves_.size(); ++l)
-            index[leaves_[l]->origin()] = int(l);
+            index[l] = {leaves_[l]->origin(), int(l)};
+        std::sort(index.begin(), index.end());
         neighbours_.resize(leaves_.size());
-        for (std::size_t l = 0; l < leaves_.size(); ++l)
+        tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
             for (int a = 0; a < 3; ++a)
                 for (int d = 0; d < 2; ++d) {
                     openvdb::Coord o = leaves_[l]->origin();
                     o[a] += d ? Leaf::DIM : -int(Leaf::DIM);
-                    auto it = index.find(o);
-                    neighbours_[l][2 * a + d] = it == index.end() ? -1 : it->second;
+                    const auto it = std::lower_bound(
+                        index.begin(), index.end(), o,
+                        [](const auto& entry, const openvdb::Coord& c) { return entry.first < c; });
+                    neighbours_[l][std::size_t(2 * a + d)] =
+                        it != index.end() && it->first == o ? it->second : -1;
                 }
+        });
     }
 
     std::size_t size() const { return leaves_.size() * kLeafVoxels; }
