@@ -271,17 +271,17 @@ class Renormalizer {
     Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
                  FmmOrder order, Interrupter* interrupter)
         : b_(grid, region, 2), n_(b_.size()), h_(float(grid.voxelSize()[0])),
-          bg_(grid.background()), order_(order), interrupter_(interrupter), phi_(new float[n_]),
-          dist_(new float[n_]), thin_(new std::uint8_t[n_]), neg_(b_.leafCount(), Bits{}),
-          fixed_(b_.leafCount(), Bits{}), settled_(b_.leafCount(), Bits{}) {
+          bg_(grid.background()), order_(order), interrupter_(interrupter),
+          phi_(b_.leafCount(), nullptr), dist_(new float[n_]), thin_(b_.leafCount(), Bits{}),
+          neg_(b_.leafCount(), Bits{}), fixed_(b_.leafCount(), Bits{}),
+          settled_(b_.leafCount(), Bits{}) {
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);
-            const float* values = leaf.buffer().data();
-            float* phi = &phi_[l << 9];
+            // The leaves' values are read where they are: nothing writes them before the
+            // write-back.
+            const float* phi = phi_[l] = leaf.buffer().data();
             float* dist = &dist_[l << 9];
-            std::memcpy(phi, values, sizeof(float) * kLeafVoxels);
-            std::memset(&thin_[l << 9], 0, kLeafVoxels);
             // Free voxels start from their own values (their order is nearly right). Two loops,
             // so that this one is vectorized.
             for (int i = 0; i < kLeafVoxels; ++i) {
@@ -363,28 +363,29 @@ class Renormalizer {
         tbb::enumerable_thread_specific<std::vector<std::size_t>> found;
         forEachLeaf([&](std::size_t l) {
             forEachBit(acrossSurface(l, true), [&](int off) {
-                const std::size_t i = (l << 9) + std::size_t(off);
-                thin_[i] = 1;
-                found.local().push_back(i);
+                set(thin_[l], off);
+                found.local().push_back((l << 9) + std::size_t(off));
             });
         });
         std::vector<std::size_t> ring;
         for (const auto& f : found)
             ring.insert(ring.end(), f.begin(), f.end());
-        for (std::uint8_t r = 2; r <= 3; ++r) {
+        for (int r = 2; r <= 3; ++r) {
             std::vector<std::size_t> next;
             for (const std::size_t i : ring)
                 forEachAxis([&](auto a) {
                     for (const int dir : {-1, 1}) {
                         const std::size_t j = b_.neighbour(i, dir, a);
-                        if (j == Domain::npos || thin_[j]) continue;
-                        thin_[j] = r;
+                        if (j == Domain::npos || isSet(thin_[j >> 9], int(j & 511))) continue;
+                        set(thin_[j >> 9], int(j & 511));
                         next.push_back(j);
                     }
                 });
             ring = std::move(next);
         }
     }
+
+    float phi(std::size_t i) const { return phi_[i >> 9][i & 511]; }
 
     // 1. Seeds (voxels with a face neighbour across the surface): phi / |grad phi| with
     //    central differences, which turns a sampled field that is no longer a distance back
@@ -394,7 +395,7 @@ class Renormalizer {
         tbb::enumerable_thread_specific<std::size_t> count(0);
         const float h = h_;
         const auto seedOne = [&](std::size_t i) {
-            const float p = phi_[i];
+            const float p = phi(i);
             double inv2 = 0.0, grad2 = 0.0;
             float nearestCrossing = kInf;
             bool crossing = false, central = true;
@@ -407,7 +408,7 @@ class Renormalizer {
                         central = false;
                         continue;
                     }
-                    const float q = phi_[j];
+                    const float q = phi(j);
                     side[dir > 0] = q;
                     if (negative(q) == negative(p)) continue;
                     crossing = true;
@@ -425,7 +426,7 @@ class Renormalizer {
             });
             if (!crossing) return false;
             float d;
-            if (!central || thin_[i] != 0) {
+            if (!central || isSet(thin_[i >> 9], int(i & 511))) {
                 // On or next to a feature about one voxel thin (the surface on both sides along
                 // an axis) no gradient estimate is trustworthy, so the value is kept:
                 // recomputing it would move its crossings a little every time and let the
@@ -799,11 +800,13 @@ class Renormalizer {
     const float h_, bg_;
     const FmmOrder order_;
     Interrupter* const interrupter_;
-    // Every entry is written by the constructor's parallel loop over the leaves, so these
-    // are allocated without the serial zeroing of a std::vector (8 MB for a drag segment).
-    std::unique_ptr<float[]> phi_;
+    // Per leaf: its values (the grid's, as they were sampled).
+    std::vector<const float*> phi_;
+    // Every entry is written by the constructor's parallel loop over the leaves, so this is
+    // allocated without the serial zeroing of a std::vector (4 MB for a drag segment).
     std::unique_ptr<float[]> dist_; // the distance found so far (kInf: none yet)
-    std::unique_ptr<std::uint8_t[]> thin_;
+    // Per leaf: the voxels on or next to a feature one voxel thin (flagThin).
+    std::vector<Bits> thin_;
     // Per leaf: the voxels inside, the fixed ones (outside the region: boundary values), and
     // those settled before the solve (fixed, and the seeds).
     std::vector<Bits> neg_, fixed_, settled_;
