@@ -144,7 +144,8 @@ class LeafVertices {
 
 // Meshes the leaf at `origin` into `chunk`, whose vectors keep their storage: re-meshing a
 // segment's leaves allocates nothing once their chunks have grown.
-// Returns whether it meshed it (not when the chunk was made from the same values).
+// Returns whether the chunk changed: made again, or emptied (a chunk made from the same
+// values, or a leaf without surface that had none, is left as it is).
 bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) {
     const Grid::TreeType::LeafNodeType* leaf = grid.tree().probeConstLeaf(origin);
     std::optional<LeafBlock> block;

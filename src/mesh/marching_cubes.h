@@ -24,7 +24,7 @@ struct MeshChunk {
     std::vector<Eigen::Vector3i> triangles;
     double volume = 0.0; // the enclosedVolume of its triangles (their part of the whole)
     // A hash of everything the triangles were made from (the values the leaf's cubes and
-    // normals read, its active voxels, the voxel size; 0: none): a leaf whose hash is
+    // normals read, its active voxels, the grid's placement; 0: none): a leaf whose hash is
     // unchanged is not meshed again.
     std::uint64_t madeFrom = 0;
 };
@@ -41,8 +41,8 @@ class SurfaceMesher {
   public:
     // Meshes every active leaf; a cancelled rebuild (Cancelled) changes nothing.
     void rebuild(const Grid& grid, Interrupter* interrupter = nullptr);
-    // Re-meshes the leaves overlapping `touched` grown by one voxel whose values changed;
-    // returns how many were meshed.
+    // Re-meshes the leaves overlapping `touched` grown by two voxels (as far as a leaf's
+    // normals read) whose values changed; returns how many chunks were made or emptied.
     std::size_t update(const Grid& grid, const openvdb::CoordBBox& touched);
 
     const std::map<openvdb::Coord, MeshChunk>& chunks() const { return chunks_; }
@@ -57,8 +57,7 @@ class SurfaceMesher {
     TriangleMesh weld() const;
 
   private:
-    // Returns how many leaves were meshed (those with a chunk made from other values, and
-    // those without one).
+    // Returns how many chunks changed (made again, or emptied: meshLeaf).
     std::size_t meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
                            Interrupter* interrupter = nullptr);
     std::map<openvdb::Coord, MeshChunk> chunks_;
