@@ -65,7 +65,7 @@ class Domain {
                     const auto it = std::lower_bound(
                         index.begin(), index.end(), o,
                         [](const auto& entry, const openvdb::Coord& c) { return entry.first < c; });
-                    neighbours_[l][std::size_t(2 * a + d)] =
+                    neighbours_[l][2 * std::size_t(a) + std::size_t(d)] =
                         it != index.end() && it->first == o ? it->second : -1;
                 }
         });

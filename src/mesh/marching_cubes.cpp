@@ -61,7 +61,7 @@ class LeafBlock {
         bool any = false, all = true;
         for (int x = 1; x <= kDim + 1; ++x)
             for (int y = 1; y <= kDim + 1; ++y) {
-                const float* row = &values_[std::size_t((x * kSpan + y) * kSpan + 1)];
+                const float* row = &values_[(std::size_t(x) * kSpan + std::size_t(y)) * kSpan + 1];
                 for (int z = 0; z <= kDim; ++z) {
                     any |= row[z] < 0.0f;
                     all &= row[z] < 0.0f;
