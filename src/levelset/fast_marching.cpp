@@ -370,7 +370,7 @@ class Renormalizer {
         std::vector<std::size_t> ring;
         for (const auto& f : found)
             ring.insert(ring.end(), f.begin(), f.end());
-        for (int r = 2; r <= 3; ++r) {
+        for (int step = 0; step < 2; ++step) { // rings 2 and 3
             std::vector<std::size_t> next;
             for (const std::size_t i : ring)
                 forEachAxis([&](auto a) {
