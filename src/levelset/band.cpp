@@ -96,10 +96,10 @@ BandReport checkBand(const Grid& grid) {
     openvdb::tools::CheckLevelSet<Grid> check(grid);
     r.vdbCheck = check.check(/*updateMask=*/false);
     const double h = grid.voxelSize()[0];
-    const float limit = float(grid.background() + h);
+    const float limit = float(grid.background() + h), inner = float(grid.background() - h);
     openvdb::tree::LeafManager<const Grid::TreeType> leaves(grid.tree());
     struct Counts {
-        std::size_t active = 0, near = 0, unit = 0, beyond = 0;
+        std::size_t active = 0, near = 0, unit = 0, beyond = 0, holes = 0;
     };
     const Counts c = tbb::parallel_reduce(
         leaves.leafRange(), Counts(),
@@ -110,8 +110,21 @@ BandReport checkBand(const Grid& grid) {
                     ++acc.active;
                     const float v = *it;
                     if (std::abs(v) > limit) ++acc.beyond;
-                    if (!nextToCrossing(*leaf, it.pos(), acc_)) continue;
                     const openvdb::Coord ijk = it.getCoord();
+                    // Distances change by at most a voxel from one voxel to the next: the
+                    // neighbours of a voxel this deep lie within the band.
+                    if (std::abs(v) < inner)
+                        for (int a = 0; a < 3; ++a)
+                            for (const int d : {-1, 1}) {
+                                openvdb::Coord n = ijk;
+                                n[a] += d;
+                                if (!acc_.isValueOn(n)) {
+                                    ++acc.holes;
+                                    a = 3;
+                                    break;
+                                }
+                            }
+                    if (!nextToCrossing(*leaf, it.pos(), acc_)) continue;
                     ++acc.near;
                     const double len = centralGradient(acc_, ijk, h).norm();
                     if (len >= 0.9 && len <= 1.1) ++acc.unit;
@@ -124,12 +137,14 @@ BandReport checkBand(const Grid& grid) {
             a.near += b.near;
             a.unit += b.unit;
             a.beyond += b.beyond;
+            a.holes += b.holes;
             return a;
         });
     r.activeVoxels = c.active;
     r.nearInterface = c.near;
     r.unitGradient = c.unit;
     r.beyondBand = c.beyond;
+    r.bandHoles = c.holes;
     return r;
 }
 

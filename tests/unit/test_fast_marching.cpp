@@ -77,6 +77,7 @@ void renormalizes(const char* name, GridPtr g,
     EXPECT_LT(e2.maxBand, 0.05) << name; // second order (first order: about 0.1 on the torus)
     const BandReport band = checkBand(*g);
     EXPECT_EQ(band.beyondBand, 0u);
+    EXPECT_EQ(band.bandHoles, 0u);
     EXPECT_EQ(band.vdbCheck, "");
     EXPECT_GE(band.unitGradientFraction(), 0.99);
 }

@@ -69,6 +69,7 @@ void expectValidBand(const Grid& g, const std::string& what) {
     const BandReport r = checkBand(g);
     EXPECT_EQ(r.vdbCheck, "") << what;
     EXPECT_EQ(r.beyondBand, 0u) << what;
+    EXPECT_EQ(r.bandHoles, 0u) << what;
     EXPECT_GE(r.unitGradientFraction(), g.voxelSize()[0] > 1.0 / 40 ? 0.9 : 0.95) << what;
 }
 
