@@ -39,6 +39,7 @@ struct AdvectStats {
     std::size_t interfaceVoxels = 0; // forward-mapped to grow the band
     std::size_t sampledVoxels = 0;
     double widenedTo = 0.0; // band half-width used for sampling, in voxels
+    int sampledReach = 0;   // how far around the images of the surface the band was sampled
     // The work, counted: what a segment reads and writes follows the brush, never the
     // size of the model (the same stroke counts the same on a grid holding more shapes).
     std::size_t voxelsVisited = 0; // scanned for the interface, sampled, marched over

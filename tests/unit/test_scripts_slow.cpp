@@ -122,6 +122,20 @@ TEST(Advect, PinchOpensAHole) {
     EXPECT_TRUE(t.consistentlyOriented());
 }
 
+TEST(Advect, APinchLeavesTheWholeBand) {
+    // At 1/128 in both variants: sampling reaches two voxels around the images of the
+    // surface, and the band's outer voxels there lay in 108 leaves no sample had made when
+    // they were not made afterwards (at 1/64 none did).
+    StrokeScript script = readStrokeScript(dataPath("two_handles"));
+    script.strokes.resize(1);
+    const GridPtr g = applyScript(script, SWEEPERS_DATA_DIR, 1.0 / 128);
+    const BandReport r = checkBand(*g);
+    std::printf("[ band ] the first pinch of two_handles at 1/128: %zu active, %zu band holes\n",
+                r.activeVoxels, r.bandHoles);
+    EXPECT_EQ(r.bandHoles, 0u);
+    EXPECT_EQ(r.beyondBand, 0u);
+}
+
 TEST(Advect, SwirlsKeepVolumeWhereSweepsDoNot) {
     // The 50-stroke swirl script against sweeps of a ball along the same moves.
     const StrokeScript swirls = readStrokeScript(dataPath("starfish_swirls"));
