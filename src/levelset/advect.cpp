@@ -644,20 +644,37 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     stats.leavesFlooded += floodSignsIn(grid.tree(), moving, touched);
     if (stats.sampledReach < bandReach) {
         // The band's outer voxels may lie in leaves no sample reached: those leaves are made
-        // now (as far as the images dilated by the whole band would have made them), after
-        // the signs were re-derived, so that they take the sign of the tile they replace.
+        // now, after the signs were re-derived, so that they take the sign of the tile they
+        // replace; exactly those the images dilated by the whole band would have made (a
+        // voxel reaches the leaf next to it along an axis when it lies within `beyond` of
+        // it; a leaf more would only widen renormalization's domain).
         const int beyond = bandReach - stats.sampledReach;
+        const auto near = [&](int d, int c) {
+            return d < 0 ? c < beyond : d > 0 ? c >= 8 - beyond : true;
+        };
+        std::uint64_t across[3][3] = {}; // the (y, z) bits of a word within reach of (dy, dz)
+        for (int y = 0; y < 8; ++y)
+            for (int z = 0; z < 8; ++z)
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dz = -1; dz <= 1; ++dz)
+                        if (near(dy, y) && near(dz, z))
+                            across[dy + 1][dz + 1] |= std::uint64_t(1) << (8 * y + z);
         auto acc = grid.getAccessor();
         for (auto it = mask->tree().cbeginLeaf(); it; ++it) {
-            openvdb::CoordBBox box;
-            it->evalActiveBoundingBox(box);
-            if (box.empty()) continue;
-            box.expand(beyond);
-            box.intersect(touched);
-            for (int x = box.min().x() & ~7; x <= box.max().x(); x += 8)
-                for (int y = box.min().y() & ~7; y <= box.max().y(); y += 8)
-                    for (int z = box.min().z() & ~7; z <= box.max().z(); z += 8)
-                        if (!acc.probeConstLeaf({x, y, z})) acc.touchLeaf({x, y, z});
+            for (int dx = -1; dx <= 1; ++dx) {
+                std::uint64_t rows = 0;
+                for (int x = 0; x < 8; ++x)
+                    if (near(dx, x)) rows |= it->getValueMask().getWord<std::uint64_t>(x);
+                if (!rows) continue;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dz = -1; dz <= 1; ++dz) {
+                        if (!(rows & across[dy + 1][dz + 1])) continue;
+                        const openvdb::Coord o = it->origin().offsetBy(8 * dx, 8 * dy, 8 * dz);
+                        if (touched.hasOverlap(openvdb::CoordBBox::createCube(o, 8)) &&
+                            !acc.probeConstLeaf(o))
+                            acc.touchLeaf(o);
+                    }
+            }
         }
     }
     stats.sampleSeconds = secondsSince(t0);
