@@ -344,25 +344,17 @@ bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
             words(leaf, on);
             for (int x = 0; x < 8; ++x)
                 missing[x] = crossing.getWord<Word>(x) & ~on[x];
-            const auto along = [&](auto axis) {
-                constexpr int A = decltype(axis)::value;
-                for (const int dir : {-1, 1}) {
-                    openvdb::Coord o = leaf.origin();
-                    o[A] += dir * int(LeafNode::DIM);
-                    // A tile's voxels hold no sample.
-                    const LeafNode* next = acc.probeConstLeaf(o);
-                    Word n[8] = {};
+            leafwords::forEachFace(
+                leaf, acc, [&](auto axis, int dir, const openvdb::Coord&, const LeafNode* next) {
+                    constexpr int A = decltype(axis)::value;
+                    Word n[8] = {}; // a tile's voxels hold no sample
                     if (next) words(*next, n);
                     for (int x = 0; x < 8; ++x) {
                         const Word neighbourOn =
                             leafwords::stepped<A>(on, x, dir, leafwords::facing<A>(n, x, dir));
                         missing[x] |= crossing.getWord<Word>(x) & ~neighbourOn;
                     }
-                }
-            };
-            along(std::integral_constant<int, 0>{});
-            along(std::integral_constant<int, 1>{});
-            along(std::integral_constant<int, 2>{});
+                });
             if (std::any_of(missing, missing + 8, [](Word w) { return w != 0; })) all = false;
         }
     });
@@ -481,9 +473,8 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // voxels next to the new crossing and their face neighbours) lies within kSeedReach of
     // them, and sampling is checked to have reached it all (else the images are dilated as
     // far as the whole band reaches, `bandReach`). Renormalization gives the voxels between
-    // there and the band's edge their distances: sampling them too, as the band's edge
-    // dilated by a cube would, took a third of a segment's sampling and read some 40% more
-    // voxels than the band holds.
+    // there and the band's edge their distances: sampling them too, as dilating the images
+    // by the whole band did, read about twice as many voxels as the band holds.
     const int bandReach = int(std::ceil(halfWidth)) + 1;
     const int reach = options.resampleEachSubStep ? bandReach : std::min(kSeedReach, bandReach);
     dilateByCube(mask->tree(), reach);

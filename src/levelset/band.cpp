@@ -55,13 +55,10 @@ LeafNode::NodeMaskType crossingVoxels(const LeafNode& leaf, const Grid::ConstAcc
     for (std::size_t x = 0; x < 8; ++x)
         own[x] = signs(v, 64 * x, 64, 1);
     LeafNode::NodeMaskType out;
-    const auto along = [&](auto axis) {
-        constexpr int A = decltype(axis)::value;
-        for (const int dir : {-1, 1}) {
-            openvdb::Coord o = leaf.origin();
-            o[A] += dir * int(LeafNode::DIM);
+    leafwords::forEachFace(
+        leaf, acc, [&](auto axis, int dir, const openvdb::Coord& o, const LeafNode* next) {
+            constexpr int A = decltype(axis)::value;
             // The facing layer of the next leaf, or a tile's one sign where there is none.
-            const LeafNode* next = acc.probeConstLeaf(o);
             const float* n = next ? next->buffer().data() : nullptr;
             const bool tileInside = !next && acc.getValue(o) < 0.0f;
             for (int x = 0; x < 8; ++x) {
@@ -83,11 +80,7 @@ LeafNode::NodeMaskType crossingVoxels(const LeafNode& leaf, const Grid::ConstAcc
                 out.getWord<Word>(openvdb::Index(x)) |=
                     leafwords::stepped<A>(own, x, dir, facing) ^ own[x];
             }
-        }
-    };
-    along(std::integral_constant<int, 0>{});
-    along(std::integral_constant<int, 1>{});
-    along(std::integral_constant<int, 2>{});
+        });
     return out;
 }
 
@@ -113,17 +106,16 @@ BandReport checkBand(const Grid& grid) {
                     const openvdb::Coord ijk = it.getCoord();
                     // Distances change by at most a voxel from one voxel to the next: the
                     // neighbours of a voxel this deep lie within the band.
-                    if (std::abs(v) < inner)
+                    const auto offBeside = [&] {
                         for (int a = 0; a < 3; ++a)
                             for (const int d : {-1, 1}) {
                                 openvdb::Coord n = ijk;
                                 n[a] += d;
-                                if (!acc_.isValueOn(n)) {
-                                    ++acc.holes;
-                                    a = 3;
-                                    break;
-                                }
+                                if (!acc_.isValueOn(n)) return true;
                             }
+                        return false;
+                    };
+                    if (std::abs(v) < inner && offBeside()) ++acc.holes;
                     if (!nextToCrossing(*leaf, it.pos(), acc_)) continue;
                     ++acc.near;
                     const double len = centralGradient(acc_, ijk, h).norm();

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <type_traits>
 
 namespace sweepers::leafwords {
 
@@ -34,6 +35,23 @@ template <int A> Word facing(const Word* next, int x, int dir) {
         return dir > 0 ? next[x] & kY0 : next[x] >> 56;
     else
         return next[dir > 0 ? 0 : 7];
+}
+
+// Calls f(axis, dir, origin, next) for the six faces of `leaf`: axis an
+// std::integral_constant of 0, 1 or 2, dir +-1, origin that of the leaf across the face and
+// next that leaf, or nullptr where a tile is.
+template <typename Leaf, typename Accessor, typename F>
+void forEachFace(const Leaf& leaf, const Accessor& acc, F&& f) {
+    const auto along = [&](auto axis) {
+        for (const int dir : {-1, 1}) {
+            auto o = leaf.origin();
+            o[decltype(axis)::value] += dir * int(Leaf::DIM);
+            f(axis, dir, o, acc.probeConstLeaf(o));
+        }
+    };
+    along(std::integral_constant<int, 0>{});
+    along(std::integral_constant<int, 1>{});
+    along(std::integral_constant<int, 2>{});
 }
 
 } // namespace sweepers::leafwords

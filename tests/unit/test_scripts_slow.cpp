@@ -124,8 +124,9 @@ TEST(Advect, PinchOpensAHole) {
 
 TEST(Advect, APinchLeavesTheWholeBand) {
     // At 1/128 in both variants: sampling reaches two voxels around the images of the
-    // surface, and the band's outer voxels there lay in 108 leaves no sample had made when
-    // they were not made afterwards (at 1/64 none did).
+    // surface, and where the band's outer voxels lie in leaves no sample made, those leaves
+    // are made afterwards; when they were not, the band missed 108 of its voxels here (at
+    // 1/64 none).
     StrokeScript script = readStrokeScript(dataPath("two_handles"));
     script.strokes.resize(1);
     const GridPtr g = applyScript(script, SWEEPERS_DATA_DIR, 1.0 / 128);
