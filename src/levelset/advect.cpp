@@ -361,6 +361,40 @@ bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
     return all;
 }
 
+// Makes the leaves of `grid` within `beyond` voxels of the mask's voxels that overlap `box`,
+// exactly those dilating the mask by a cube of that radius would make: a voxel reaches the
+// leaf next to it along an axis when it lies within `beyond` of it (a leaf more would only
+// widen renormalization's domain). Along x the words themselves are chosen; along y and z,
+// the bits of a word.
+void makeLeavesWithin(Grid& grid, const openvdb::MaskTree& mask, int beyond,
+                      const openvdb::CoordBBox& box) {
+    const auto near = [&](int d, int c) {
+        return d < 0 ? c < beyond : d > 0 ? c >= 8 - beyond : true;
+    };
+    std::uint64_t across[3][3] = {}; // the (y, z) bits of a word within reach of (dy, dz)
+    for (int y = 0; y < 8; ++y)
+        for (int z = 0; z < 8; ++z)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz)
+                    if (near(dy, y) && near(dz, z))
+                        across[dy + 1][dz + 1] |= std::uint64_t(1) << (8 * y + z);
+    auto acc = grid.getAccessor();
+    const auto make = [&](const openvdb::Coord& o) {
+        if (box.hasOverlap(openvdb::CoordBBox::createCube(o, 8)) && !acc.probeConstLeaf(o))
+            acc.touchLeaf(o);
+    };
+    for (auto it = mask.cbeginLeaf(); it; ++it)
+        for (int dx = -1; dx <= 1; ++dx) {
+            std::uint64_t rows = 0;
+            for (int x = 0; x < 8; ++x)
+                if (near(dx, x)) rows |= it->getValueMask().getWord<std::uint64_t>(x);
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz)
+                    if (rows & across[dy + 1][dz + 1])
+                        make(it->origin().offsetBy(8 * dx, 8 * dy, 8 * dz));
+        }
+}
+
 } // namespace
 
 openvdb::CoordBBox changedRegion(const Grid& grid, const StepDeformation& seg) {
@@ -633,41 +667,10 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     }
     stats.voxelsVisited += stats.sampledVoxels;
     stats.leavesFlooded += floodSignsIn(grid.tree(), moving, touched);
-    if (stats.sampledReach < bandReach) {
-        // The band's outer voxels may lie in leaves no sample reached: those leaves are made
-        // now, after the signs were re-derived, so that they take the sign of the tile they
-        // replace; exactly those the images dilated by the whole band would have made (a
-        // voxel reaches the leaf next to it along an axis when it lies within `beyond` of
-        // it; a leaf more would only widen renormalization's domain).
-        const int beyond = bandReach - stats.sampledReach;
-        const auto near = [&](int d, int c) {
-            return d < 0 ? c < beyond : d > 0 ? c >= 8 - beyond : true;
-        };
-        std::uint64_t across[3][3] = {}; // the (y, z) bits of a word within reach of (dy, dz)
-        for (int y = 0; y < 8; ++y)
-            for (int z = 0; z < 8; ++z)
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dz = -1; dz <= 1; ++dz)
-                        if (near(dy, y) && near(dz, z))
-                            across[dy + 1][dz + 1] |= std::uint64_t(1) << (8 * y + z);
-        auto acc = grid.getAccessor();
-        for (auto it = mask->tree().cbeginLeaf(); it; ++it) {
-            for (int dx = -1; dx <= 1; ++dx) {
-                std::uint64_t rows = 0;
-                for (int x = 0; x < 8; ++x)
-                    if (near(dx, x)) rows |= it->getValueMask().getWord<std::uint64_t>(x);
-                if (!rows) continue;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dz = -1; dz <= 1; ++dz) {
-                        if (!(rows & across[dy + 1][dz + 1])) continue;
-                        const openvdb::Coord o = it->origin().offsetBy(8 * dx, 8 * dy, 8 * dz);
-                        if (touched.hasOverlap(openvdb::CoordBBox::createCube(o, 8)) &&
-                            !acc.probeConstLeaf(o))
-                            acc.touchLeaf(o);
-                    }
-            }
-        }
-    }
+    // The band's outer voxels may lie in leaves no sample reached: those leaves are made now,
+    // after the signs were re-derived, so that they take the sign of the tile they replace.
+    if (stats.sampledReach < bandReach)
+        makeLeavesWithin(grid, mask->tree(), bandReach - stats.sampledReach, touched);
     stats.sampleSeconds = secondsSince(t0);
 
     // 3. Renormalize the changed region (and the band around it).

@@ -376,7 +376,7 @@ class Renormalizer {
                 forEachAxis([&](auto a) {
                     for (const int dir : {-1, 1}) {
                         const std::size_t j = b_.neighbour(i, dir, a);
-                        if (j == Domain::npos || isSet(thin_[j >> 9], int(j & 511))) continue;
+                        if (j == Domain::npos || thin(j)) continue;
                         set(thin_[j >> 9], int(j & 511));
                         next.push_back(j);
                     }
@@ -386,6 +386,7 @@ class Renormalizer {
     }
 
     float phi(std::size_t i) const { return phi_[i >> 9][i & 511]; }
+    bool thin(std::size_t i) const { return isSet(thin_[i >> 9], int(i & 511)); }
 
     // 1. Seeds (voxels with a face neighbour across the surface): phi / |grad phi| with
     //    central differences, which turns a sampled field that is no longer a distance back
@@ -426,7 +427,7 @@ class Renormalizer {
             });
             if (!crossing) return false;
             float d;
-            if (!central || isSet(thin_[i >> 9], int(i & 511))) {
+            if (!central || thin(i)) {
                 // On or next to a feature about one voxel thin (the surface on both sides along
                 // an axis) no gradient estimate is trustworthy, so the value is kept:
                 // recomputing it would move its crossings a little every time and let the
