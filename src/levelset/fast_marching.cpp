@@ -274,7 +274,7 @@ class Renormalizer {
           bg_(grid.background()), order_(order), interrupter_(interrupter),
           phi_(b_.leafCount(), nullptr), dist_(new float[n_]), thin_(b_.leafCount(), Bits{}),
           neg_(b_.leafCount(), Bits{}), fixed_(b_.leafCount(), Bits{}),
-          settled_(b_.leafCount(), Bits{}) {
+          settled_(b_.leafCount(), Bits{}), beyond_(b_.leafCount(), Bits{}) {
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);
@@ -302,6 +302,27 @@ class Renormalizer {
                     free[x] &= mask ? mask->getValueMask().getWord<std::uint64_t>(x) : 0;
             }
             fixed_[l] = ~free;
+        });
+        // The band may have to grow past the free voxels: an inactive voxel next to one is
+        // free too (it has no value to keep), to be reached by the solve only: it starts
+        // without a value and is never a seed (what it holds is stale). Kept fixed, it stayed
+        // off where a free voxel at the edge of `only` came within bg - h of the surface: a
+        // hole in the band (the strangle of data/strangle_torus.json left four at 1/32).
+        std::vector<Bits> free(b_.leafCount());
+        for (std::size_t l = 0; l < b_.leafCount(); ++l)
+            free[l] = ~fixed_[l];
+        tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
+            const Bits next =
+                grown(free[l]) | nextTo(false, [&](auto a, int dir, Bits& out, Bits& valid) {
+                    b_.stepped<decltype(a)::value>(free, l, dir, out, valid);
+                });
+            const auto& active = b_.leaf(l).getValueMask();
+            Bits& added = beyond_[l];
+            for (std::size_t x = 0; x < 8; ++x) {
+                added[x] = next[x] & ~active.getWord<std::uint64_t>(int(x)) & fixed_[l][x];
+                fixed_[l][x] &= ~added[x];
+            }
+            forEachBit(added, [&](int off) { dist_[(l << 9) + std::size_t(off)] = kInf; });
             settled_[l] = fixed_[l];
         });
     }
@@ -451,7 +472,7 @@ class Renormalizer {
         forEachLeaf([&](std::size_t l) {
             Bits candidates = acrossSurface(l, false);
             for (int x = 0; x < 8; ++x)
-                candidates[x] &= ~settled_[l][x];
+                candidates[x] &= ~settled_[l][x] & ~beyond_[l][x];
             forEachBit(candidates, [&](int off) {
                 if (seedOne((l << 9) + std::size_t(off))) set(settled_[l], off);
             });
@@ -811,6 +832,9 @@ class Renormalizer {
     // Per leaf: the voxels inside, the fixed ones (outside the region: boundary values), and
     // those settled before the solve (fixed, and the seeds).
     std::vector<Bits> neg_, fixed_, settled_;
+    // Per leaf: the inactive voxels next to free ones, free so that the band can grow into
+    // them.
+    std::vector<Bits> beyond_;
     // Per leaf: the settled voxels close enough to the surface to bring a neighbour into the
     // band (set before the solve).
     std::vector<Bits> sources_;

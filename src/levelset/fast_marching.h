@@ -18,8 +18,9 @@
 //  3. voxels past the half-width are deactivated and set to +-background.
 //
 // Only a box of the grid is recomputed, on the leaves that overlap it; the voxels around
-// it keep their values and act as fixed boundary values. The band must already lie in
-// leaves (advection activates it before sampling).
+// it keep their values and act as fixed boundary values, but an inactive voxel next to a
+// recomputed one joins the band where the solve brings it in (it has no value to keep). The
+// band must already lie in leaves (advection activates it before sampling).
 #pragma once
 
 #include "levelset/interrupt.h"

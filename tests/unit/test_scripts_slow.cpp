@@ -74,6 +74,7 @@ TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
         EXPECT_GE(r.unitGradientFraction(), minimumUnitGradientFraction(name))
             << name << " stroke " << stroke;
         EXPECT_EQ(r.beyondBand, 0u) << name << " stroke " << stroke;
+        EXPECT_EQ(r.bandHoles, 0u) << name << " stroke " << stroke;
         if (const auto it = kTopology.find(name); it != kTopology.end()) {
             ASSERT_LT(stroke, it->second.size());
             const auto [euler, components] = it->second[stroke];
@@ -84,9 +85,9 @@ TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
             EXPECT_EQ(measureLevelSet(g).components, components) << name << " stroke " << stroke;
         }
         std::printf("[ band ] %s at 1/%g, stroke %zu: %zu active, |grad| in [0.9, 1.1] on "
-                    "%.2f%% of %zu interface voxels\n",
+                    "%.2f%% of %zu interface voxels, %zu holes\n",
                     name.c_str(), 1.0 / h, stroke, r.activeVoxels, 100 * r.unitGradientFraction(),
-                    r.nearInterface);
+                    r.nearInterface, r.bandHoles);
     });
 }
 
