@@ -328,13 +328,11 @@ bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
         const auto acc = grid.getConstAccessor();
         for (std::size_t l = r.begin(); l != r.end() && all; ++l) {
             const LeafNode& leaf = *leaves[l];
-            LeafNode::NodeMaskType crossing = crossingVoxels(leaf, acc);
-            if (!box.isInside(leaf.getNodeBoundingBox())) {
-                LeafNode::NodeMaskType inside;
-                for (auto it = crossing.beginOn(); it; ++it)
-                    if (box.isInside(leaf.offsetToGlobalCoord(it.pos()))) inside.setOn(it.pos());
-                crossing = inside;
-            }
+            const LeafNode::NodeMaskType crossingAll = crossingVoxels(leaf, acc);
+            const leafwords::Words inside = leafwords::inBox(box, leaf.origin());
+            Word crossing[8];
+            for (int x = 0; x < 8; ++x)
+                crossing[x] = crossingAll.getWord<Word>(x) & inside[std::size_t(x)];
             // The leaf's active voxels, and those of a neighbour, as words.
             const auto words = [](const LeafNode& of, Word(&out)[8]) {
                 for (int x = 0; x < 8; ++x)
@@ -343,7 +341,7 @@ bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
             Word on[8], missing[8];
             words(leaf, on);
             for (int x = 0; x < 8; ++x)
-                missing[x] = crossing.getWord<Word>(x) & ~on[x];
+                missing[x] = crossing[x] & ~on[x];
             leafwords::forEachFace(
                 leaf, acc, [&](auto axis, int dir, const openvdb::Coord&, const LeafNode* next) {
                     constexpr int A = decltype(axis)::value;
@@ -352,7 +350,7 @@ bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
                     for (int x = 0; x < 8; ++x) {
                         const Word neighbourOn =
                             leafwords::stepped<A>(on, x, dir, leafwords::facing<A>(n, x, dir));
-                        missing[x] |= crossing.getWord<Word>(x) & ~neighbourOn;
+                        missing[x] |= crossing[x] & ~neighbourOn;
                     }
                 });
             if (std::any_of(missing, missing + 8, [](Word w) { return w != 0; })) all = false;

@@ -95,7 +95,7 @@ class Domain {
     // at offset x * 64 + y * 8 + z. Scans of the domain test whole words of voxels at once
     // and only visit the few voxels a test leaves, instead of reading six neighbours of
     // every voxel of every leaf.
-    using Bits = std::array<std::uint64_t, 8>;
+    using Bits = leafwords::Words;
 
     // `out` gets, for each voxel of leaf l, the bit of its neighbour one step along axis A
     // (dir = +-1) in `sets` (one Bits per leaf); `valid` gets the voxels that have such a
@@ -157,14 +157,13 @@ Bits operator~(Bits a) {
 
 // The voxels of a leaf in `bits` or next to one of them (along an axis, within the leaf).
 Bits grown(const Bits& bits) {
-    constexpr std::uint64_t z0 = 0x0101010101010101ull, z7 = z0 << 7;
     Bits out = bits;
-    for (std::size_t x = 0; x < 8; ++x) {
-        const std::uint64_t w = bits[x];
-        out[x] |= ((w >> 1) & ~z7) | ((w << 1) & ~z0) | (w >> 8) | (w << 8);
-        if (x > 0) out[x] |= bits[x - 1];
-        if (x < 7) out[x] |= bits[x + 1];
-    }
+    forEachAxis([&](auto a) {
+        for (const int dir : {-1, 1})
+            for (int x = 0; x < 8; ++x)
+                out[std::size_t(x)] |=
+                    leafwords::stepped<decltype(a)::value>(bits.data(), x, dir, 0);
+    });
     return out;
 }
 
@@ -173,22 +172,6 @@ bool isSet(const Bits& bits, int off) {
 }
 void set(Bits& bits, int off) {
     bits[std::size_t(off) >> 6] |= std::uint64_t(1) << (off & 63);
-}
-
-// The voxels of the leaf at `origin` that lie inside `box`.
-Bits inBox(const openvdb::CoordBBox& box, const openvdb::Coord& origin) {
-    const openvdb::Coord lo = openvdb::Coord::maxComponent(box.min() - origin, openvdb::Coord(0));
-    const openvdb::Coord hi = openvdb::Coord::minComponent(box.max() - origin, openvdb::Coord(7));
-    Bits out{};
-    if (lo.x() > hi.x() || lo.y() > hi.y() || lo.z() > hi.z()) return out;
-    const std::uint64_t row =
-        (std::uint64_t(0xff) >> (7 - hi.z())) & (std::uint64_t(0xff) << lo.z());
-    std::uint64_t word = 0;
-    for (int y = lo.y(); y <= hi.y(); ++y)
-        word |= row << (8 * y);
-    for (int x = lo.x(); x <= hi.x(); ++x)
-        out[std::size_t(x)] = word;
-    return out;
 }
 
 bool negative(float v) {
@@ -295,7 +278,7 @@ class Renormalizer {
                     word |= std::uint64_t(negative(phi[x * 64 + k])) << k;
                 neg[std::size_t(x)] = word;
             }
-            Bits free = inBox(region, leaf.origin());
+            Bits free = leafwords::inBox(region, leaf.origin());
             if (only) {
                 const auto* mask = only->tree().probeConstLeaf(leaf.origin());
                 for (std::size_t x = 0; x < 8; ++x)
@@ -312,10 +295,10 @@ class Renormalizer {
         for (std::size_t l = 0; l < b_.leafCount(); ++l)
             free[l] = ~fixed_[l];
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
-            const Bits next =
-                grown(free[l]) | nextTo(false, [&](auto a, int dir, Bits& out, Bits& valid) {
-                    b_.stepped<decltype(a)::value>(free, l, dir, out, valid);
-                });
+            // (Domain::stepped moves a set within the leaf as well as across its faces.)
+            const Bits next = nextTo(false, [&](auto a, int dir, Bits& out, Bits& valid) {
+                b_.stepped<decltype(a)::value>(free, l, dir, out, valid);
+            });
             const auto& active = b_.leaf(l).getValueMask();
             Bits& added = beyond_[l];
             for (std::size_t x = 0; x < 8; ++x) {

@@ -4,12 +4,15 @@
 // set one step along an axis; that step is written once, here.
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <type_traits>
 
 namespace sweepers::leafwords {
 
 using Word = std::uint64_t;
+using Words = std::array<Word, 8>;                          // a set of one leaf's voxels
 constexpr Word kZ0 = 0x0101010101010101ull, kZ7 = kZ0 << 7; // the voxels at z = 0, z = 7
 constexpr Word kY0 = 0xffull, kY7 = kY0 << 56;              // the voxels at y = 0, y = 7
 
@@ -35,6 +38,24 @@ template <int A> Word facing(const Word* next, int x, int dir) {
         return dir > 0 ? next[x] & kY0 : next[x] >> 56;
     else
         return next[dir > 0 ? 0 : 7];
+}
+
+// The voxels of the leaf at `origin` that lie inside `box` (index space, bounds included).
+template <typename Box, typename Coord> Words inBox(const Box& box, const Coord& origin) {
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+        lo[a] = std::max(box.min()[a] - origin[a], 0);
+        hi[a] = std::min(box.max()[a] - origin[a], 7);
+        if (lo[a] > hi[a]) return Words{};
+    }
+    const Word row = (Word(0xff) >> (7 - hi[2])) & (Word(0xff) << lo[2]);
+    Word word = 0;
+    for (int y = lo[1]; y <= hi[1]; ++y)
+        word |= row << (8 * y);
+    Words out{};
+    for (int x = lo[0]; x <= hi[0]; ++x)
+        out[std::size_t(x)] = word;
+    return out;
 }
 
 // Calls f(axis, dir, origin, next) for the six faces of `leaf`: axis an
