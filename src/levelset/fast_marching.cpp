@@ -18,7 +18,7 @@
 
 #include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
-#include "levelset/value_order.h"
+#include "levelset/upwind_row.h"
 
 namespace sweepers {
 
@@ -155,16 +155,31 @@ Bits operator~(Bits a) {
     return a;
 }
 
-// The voxels of a leaf in `bits` or next to one of them (along an axis, within the leaf).
-Bits grown(const Bits& bits) {
+// The voxels of a leaf whose stencils read a voxel of `bits`: those up to `reach` steps from
+// one along an axis, within the leaf (either side: an over-estimate, which only costs work).
+Bits readers(const Bits& bits, int reach) {
     Bits out = bits;
     forEachAxis([&](auto a) {
-        for (const int dir : {-1, 1})
-            for (int x = 0; x < 8; ++x)
-                out[std::size_t(x)] |=
-                    leafwords::stepped<decltype(a)::value>(bits.data(), x, dir, 0);
+        for (const int dir : {-1, 1}) {
+            Bits step = bits;
+            for (int k = 0; k < reach; ++k) {
+                Bits next;
+                for (int x = 0; x < 8; ++x)
+                    next[std::size_t(x)] =
+                        leafwords::stepped<decltype(a)::value>(step.data(), x, dir, 0);
+                step = next;
+                out = out | step;
+            }
+        }
     });
     return out;
+}
+
+bool any(const Bits& bits) {
+    leafwords::Word all = 0;
+    for (const leafwords::Word w : bits)
+        all |= w;
+    return all != 0;
 }
 
 bool isSet(const Bits& bits, int off) {
@@ -178,76 +193,85 @@ bool negative(float v) {
     return v < 0.0f;
 }
 
-// Solves sum_a c_a (u - m_a)^2 = h^2 for the largest root, using axes in increasing m_a
-// while the root stays above them (the upwind discretization of |grad u| = 1; c_a = 1 for
-// the first-order difference, 9/4 for the second-order one). Solved for w = u - m_0, where
-// every term is of the order of h^2, so single precision keeps the root to about 1e-7 h.
-float solveUpwind(float m[3], float c[3], int n, float h) {
-    // Compare and swap by selects: the order of the values is random, so branches on it
-    // would be mispredicted half the time.
-    const auto order = [&](int i, int j) {
-        const bool swap = m[j] < m[i];
-        const float mi = m[i], mj = m[j], ci = c[i], cj = c[j];
-        m[i] = swap ? mj : mi;
-        m[j] = swap ? mi : mj;
-        c[i] = swap ? cj : ci;
-        c[j] = swap ? ci : cj;
-    };
-    if (n > 1) order(0, 1);
-    if (n > 2) {
-        order(1, 2);
-        order(0, 1);
-    }
-    if (m[0] == kInf) return kInf; // no neighbour of its side has a value
-    // h / sqrt(c_0) without the root: c_0 is 1 or 9/4, whose root is 3/2 exactly.
-    float w = c[0] == 1.0f ? h : h / 1.5f;
-    // sum_k c_k (w - d_k)^2 - h^2 = A w^2 - 2 B w + C, with d_k = m_k - m_0.
-    float A = c[0], B = 0.0f, C = -h * h;
-    for (int k = 1; k < n; ++k) {
-        const float d = m[k] - m[0];
-        if (w <= d) break;
-        A += c[k];
-        B += c[k] * d;
-        C += c[k] * d * d;
-        const float disc = B * B - A * C;
-        if (disc < 0.0f) break;
-        const float root = (B + std::sqrt(disc)) / A;
-        if (root < d) break;
-        w = root;
-    }
-    return m[0] + w;
-}
-
 // One leaf of the domain and a rim of two voxels taken from its six face neighbours, in a
 // dense block: the upwind stencils (which reach two voxels along each axis) read their
 // neighbours by fixed strides, without branching on leaf borders. Each side of the surface
 // has its own copy, in which the other side's voxels read as infinitely far: an update only
 // ever reads its own side. Only face neighbours are filled; the stencils never read the
 // block's edges and corners.
+//
+// The block's rows (stride 1) are solved eight voxels at once, each from the values of its
+// neighbours as they were before (upwind::relaxRow), so a value travels one voxel along a row
+// per sweep, and as far as the sweep goes across rows. Distances grow along the normal of the
+// surface: the rows run along the leaf's axis closest to the surface's tangent plane (the
+// block is the leaf with its axes permuted), and a sweep or two settles what took one per
+// voxel of the band's depth.
 struct Block {
     static constexpr int kRim = 2, kDim = Leaf::DIM + 2 * kRim;
-    static constexpr int kStride[3] = {kDim * kDim, kDim, 1};
-    static int at(int off) {
-        return ((off >> 6) + kRim) * kStride[0] + (((off >> 3) & 7) + kRim) * kStride[1] +
-               (off & 7) + kRim;
-    }
+    static constexpr int kStride[3] = {kDim * kDim, kDim, 1}; // of the block's own axes
     static constexpr std::size_t kSize = std::size_t(kDim) * kDim * kDim;
+
+    // Lays the leaf out with its axis `axis` along the block's rows: the block's axes are the
+    // leaf's (x, y, z), (x, z, y) or (z, y, x).
+    void setRowAxis(int axis) {
+        rowAxis = axis;
+        stride = axis == 2   ? std::array<int, 3>{kStride[0], kStride[1], kStride[2]}
+                 : axis == 1 ? std::array<int, 3>{kStride[0], kStride[2], kStride[1]}
+                             : std::array<int, 3>{kStride[2], kStride[1], kStride[0]};
+    }
+    // The block index of the voxel at offset `off` of the leaf.
+    int at(int off) const {
+        return ((off >> 6) + kRim) * stride[0] + (((off >> 3) & 7) + kRim) * stride[1] +
+               ((off & 7) + kRim) * stride[2];
+    }
+
+    int rowAxis = 2;
+    std::array<int, 3> stride{};                  // the block strides of the leaf's x, y and z
     std::array<std::array<float, kSize>, 2> side; // [inside][index]
 };
+
+// The 8 x 8 bit matrix of a word, transposed: bit r * 8 + c goes to c * 8 + r (three swaps
+// of blocks of bits across the diagonal: 1 x 1, 2 x 2, then 4 x 4).
+leafwords::Word transposed8(leafwords::Word w) {
+    w = (w & 0xaa55aa55aa55aa55ull) | ((w & 0x00aa00aa00aa00aaull) << 7) |
+        ((w >> 7) & 0x00aa00aa00aa00aaull);
+    w = (w & 0xcccc3333cccc3333ull) | ((w & 0x0000cccc0000ccccull) << 14) |
+        ((w >> 14) & 0x0000cccc0000ccccull);
+    w = (w & 0xf0f0f0f00f0f0f0full) | ((w & 0x00000000f0f0f0f0ull) << 28) |
+        ((w >> 28) & 0x00000000f0f0f0f0ull);
+    return w;
+}
+
+// A voxel set of a leaf in the order of a block whose rows run along `rowAxis` (word i, bit
+// j * 8 + k for the block's axes i, j, k), or back: each permutation swaps two axes, so it is
+// its own inverse.
+Bits inBlockOrder(const Bits& bits, int rowAxis) {
+    if (rowAxis == 2) return bits;
+    Bits out{};
+    if (rowAxis == 1) { // (x, y, z) -> (x, z, y): within each word
+        for (std::size_t x = 0; x < 8; ++x)
+            out[x] = transposed8(bits[x]);
+        return out;
+    }
+    // (x, y, z) -> (z, y, x): for each y, the bits (x, z) of the eight words, transposed.
+    for (int y = 0; y < 8; ++y) {
+        leafwords::Word w = 0;
+        for (int x = 0; x < 8; ++x)
+            w |= ((bits[std::size_t(x)] >> (8 * y)) & 0xffu) << (8 * x);
+        w = transposed8(w);
+        for (int z = 0; z < 8; ++z)
+            out[std::size_t(z)] |= ((w >> (8 * z)) & 0xffu) << (8 * y);
+    }
+    return out;
+}
 
 // A solved value may still move by this fraction of a voxel: below it a leaf counts as
 // settled (its neighbours are not solved again for it).
 constexpr float kSolveTolerance = 1e-6f;
-// Passes over a leaf at most each time it is solved (the first, and those for voxels solved
-// out of order), and rounds over all leaves at most: the iteration converges in a few of
-// each (second-order updates are not monotone, so a bound guards against a cycle).
-constexpr int kMostPasses = 16, kMostRounds = 100;
-
-// What one thread needs to solve a leaf.
-struct LeafWork {
-    Block block;
-    std::vector<ValueEntry> order, scratch; // of a pass, and its sort's
-};
+// Sweeps over a leaf at most each time it is solved, and rounds over all leaves at most: the
+// iteration converges in a few of each (second-order updates are not monotone, so a bound
+// guards against a cycle).
+constexpr int kMostSweeps = 32, kMostRounds = 100;
 
 class Renormalizer {
   public:
@@ -257,7 +281,8 @@ class Renormalizer {
           bg_(grid.background()), order_(order), interrupter_(interrupter),
           phi_(b_.leafCount(), nullptr), dist_(new float[n_]), thin_(b_.leafCount(), Bits{}),
           neg_(b_.leafCount(), Bits{}), fixed_(b_.leafCount(), Bits{}),
-          settled_(b_.leafCount(), Bits{}), beyond_(b_.leafCount(), Bits{}) {
+          settled_(b_.leafCount(), Bits{}), beyond_(b_.leafCount(), Bits{}),
+          layout_(b_.leafCount(), 2) {
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);
@@ -271,6 +296,7 @@ class Renormalizer {
                 const float a = std::abs(phi[i]);
                 dist[i] = a < bg_ ? a : kInf;
             }
+            layout_[l] = layoutOf(phi);
             Bits& neg = neg_[l];
             for (int x = 0; x < 8; ++x) {
                 std::uint64_t word = 0;
@@ -308,6 +334,28 @@ class Renormalizer {
             forEachBit(added, [&](int off) { dist_[(l << 9) + std::size_t(off)] = kInf; });
             settled_[l] = fixed_[l];
         });
+    }
+
+    // How leaf l's block is laid out and swept (bits 0-1: the leaf axis along its rows; bits
+    // 2 and 3: whether the first sweep of the outside goes down the block's first and second
+    // axes, the inside going the other way). From the leaf's mean gradient (phi clamped to
+    // the band, differences summed over a quarter of its lines): the rows run along the axis
+    // it has least of, and each side is first swept the way its distances grow.
+    std::uint8_t layoutOf(const float* phi) const {
+        const auto d = [&](int off) { return std::clamp(phi[off], -bg_, bg_); };
+        float g[3] = {0.0f, 0.0f, 0.0f};
+        for (int p = 0; p < 8; p += 2)
+            for (int q = 0; q < 8; q += 2) {
+                g[0] += d(7 * 64 + p * 8 + q) - d(p * 8 + q);
+                g[1] += d(p * 64 + 7 * 8 + q) - d(p * 64 + q);
+                g[2] += d(p * 64 + q * 8 + 7) - d(p * 64 + q * 8);
+            }
+        int axis = 0;
+        for (int a = 1; a < 3; ++a)
+            if (std::abs(g[a]) < std::abs(g[axis])) axis = a;
+        // The leaf axes along the block's first and second axes (Block::setRowAxis).
+        const int first = axis == 0 ? 2 : 0, second = axis == 1 ? 2 : 1;
+        return std::uint8_t(axis | (g[first] < 0.0f) << 2 | (g[second] < 0.0f) << 3);
     }
 
     FmmStats run(const openvdb::CoordBBox& region, Grid& grid) {
@@ -475,7 +523,10 @@ class Renormalizer {
 
     // Copies leaf l and `rim` layers of its face neighbours (1 or 2) into the block.
     void load(std::size_t l, int rim, Block& block) const {
-        constexpr int R = Block::kRim, X = Block::kStride[0], Y = Block::kStride[1];
+        constexpr int R = Block::kRim;
+        block.setRowAxis(layout_[l] & 3);
+        const auto X = std::size_t(block.stride[0]), Y = std::size_t(block.stride[1]),
+                   Z = std::size_t(block.stride[2]);
         // Voxel `off` of a leaf whose distances start at d and whose inside voxels are `inside`.
         // (Selects, not stores through a side index: they compile without branches.)
         const auto put = [&](const float* d, const Bits& inside, int off, int b) {
@@ -487,15 +538,15 @@ class Renormalizer {
         const float* own = &dist_[l << 9];
         for (int x = 0; x < 8; ++x)
             for (int y = 0; y < 8; ++y) {
-                const auto b = std::size_t((x + R) * X) + std::size_t((y + R) * Y + R);
+                const std::size_t b = std::size_t(x + R) * X + std::size_t(y + R) * Y + R * Z;
                 const unsigned row = unsigned(neg_[l][std::size_t(x)] >> (8 * y)) & 0xffu;
                 const float* d = own + std::size_t(x) * 64 + std::size_t(y) * 8;
                 float* in = &block.side[1][b];
                 float* out = &block.side[0][b];
-                for (int z = 0; z < 8; ++z) {
+                for (std::size_t z = 0; z < 8; ++z) {
                     const bool inside = (row >> z) & 1u;
-                    in[z] = inside ? d[z] : kInf;
-                    out[z] = inside ? kInf : d[z];
+                    in[z * Z] = inside ? d[z] : kInf;
+                    out[z * Z] = inside ? kInf : d[z];
                 }
             }
         for (int k = 0; k < 6; ++k) {
@@ -505,13 +556,14 @@ class Renormalizer {
             const float* from = nl < 0 ? nullptr : &dist_[std::size_t(nl) << 9];
             // The two axes across the face, as strides in the block and in a leaf.
             const int u = axis == 0 ? 1 : 0, w = axis == 2 ? 1 : 2;
-            const int bu = Block::kStride[u], bw = Block::kStride[w];
+            const int bu = block.stride[std::size_t(u)], bw = block.stride[std::size_t(w)];
             const int lu = 1 << (6 - 3 * u), lw = 1 << (6 - 3 * w), la = 1 << (6 - 3 * axis);
             for (int t = 1; t <= rim; ++t) {
                 const int at = (up ? 7 + t : -t) + R, src = up ? t - 1 : 8 - t;
                 for (int p = 0; p < 8; ++p)
                     for (int q = 0; q < 8; ++q) {
-                        const int b = at * Block::kStride[axis] + (p + R) * bu + (q + R) * bw;
+                        const int b =
+                            at * block.stride[std::size_t(axis)] + (p + R) * bu + (q + R) * bw;
                         if (from)
                             put(from, neg_[std::size_t(nl)], src * la + p * lu + q * lw, b);
                         else
@@ -521,45 +573,14 @@ class Renormalizer {
         }
     }
 
-    // The first-order upwind value at block index b of one side's copy v.
-    float firstOrder(const float* v, int b) const {
-        float m[3];
-        for (int a = 0; a < 3; ++a)
-            m[a] = std::min(v[b - Block::kStride[a]], v[b + Block::kStride[a]]);
-        float c[3] = {1.0f, 1.0f, 1.0f};
-        return solveUpwind(m, c, 3, h_);
-    }
-
-    // The second-order upwind value (HAFMM: the one-sided difference of second order wherever
-    // the voxel beyond the upwind neighbour is closer still).
-    float secondOrder(const float* v, int b) const {
-        float m[3], c[3];
-        int k = 0;
-        for (int a = 0; a < 3; ++a) {
-            const int s = Block::kStride[a];
-            const bool down = v[b - s] <= v[b + s]; // ties take the lower side
-            const float best = down ? v[b - s] : v[b + s];
-            if (best == kInf) continue;
-            const float beyond = down ? v[b - 2 * s] : v[b + 2 * s];
-            if (beyond <= best) {
-                m[k] = (4.0f * best - beyond) / 3.0f; // (3u - 4u1 + u2) / 2h
-                c[k] = 2.25f;
-            } else {
-                m[k] = best;
-                c[k] = 1.0f;
-            }
-            ++k;
-        }
-        return k == 0 ? kInf : solveUpwind(m, c, k, h_);
-    }
-
     // 2. Solve the upwind equations for every other voxel of the region, leaf by leaf, in
     //    the manner of the fast iterative method: each leaf is solved on its own, its border
     //    values taken from its neighbours as they stand, and a leaf whose border changed hands
     //    the voxels next to it to its neighbours, which are solved again, until nothing
-    //    changes. Within a leaf, voxels are solved in increasing order of their values, so
-    //    each reads neighbours already solved (fast marching's order, without its heap): the
-    //    sampled values start the order, and they are nearly distances already. Both sides are
+    //    changes. Within a leaf, sweeps over its rows solve eight voxels at once until no
+    //    value moves (settle); a voxel solved in the order of the values, as fast marching
+    //    does, waited on the one before it: each update is a chain of a square root and a
+    //    division, about 140 cycles, where a row of eight takes about 100. Both sides are
     //    solved at once (an update reads only its own side). Everything a leaf reads is in a
     //    block of 14 KB, where fast marching's single front swept the whole region and missed
     //    the cache at nearly every voxel.
@@ -574,26 +595,14 @@ class Renormalizer {
         std::unique_ptr<std::atomic<std::uint64_t>[]> inbox(
             new std::atomic<std::uint64_t>[leaves * 8]());
         std::unique_ptr<std::atomic<bool>[]> pending(new std::atomic<bool>[leaves]());
-        sources_.assign(leaves, Bits{});
+        // Every leaf with free voxels is solved (the first time, all of them).
         forEachLeaf([&](std::size_t l) {
-            forEachBit(settled_[l], [&](int off) {
-                if (dist_[(l << 9) + std::size_t(off)] < kInf) set(sources_[l], off);
-            });
-        });
-        // Every leaf with free voxels is solved, and is handed the free voxels next to a
-        // source in a neighbouring leaf (those next to its own it finds itself).
-        forEachLeaf([&](std::size_t l) {
-            const Bits next = nextTo(false, [&](auto a, int dir, Bits& out, Bits& valid) {
-                b_.stepped<decltype(a)::value>(sources_, l, dir, out, valid);
-            });
             bool free = false;
-            for (int x = 0; x < 8; ++x) {
-                inbox[l * 8 + std::size_t(x)] = next[x] & ~settled_[l][x];
+            for (int x = 0; x < 8; ++x)
                 free |= ~settled_[l][x] != 0;
-            }
             pending[l] = free;
         });
-        tbb::enumerable_thread_specific<LeafWork> work;
+        tbb::enumerable_thread_specific<Block> blocks;
         std::vector<std::uint8_t> seen(leaves, 0); // solved once: later only what is handed in
         for (int round = 0, again = 1; again && round < kMostRounds; ++round) {
             for (const auto& leavesOfClass : classes) {
@@ -601,7 +610,7 @@ class Renormalizer {
                 tbb::parallel_for(
                     tbb::blocked_range<std::size_t>(0, leavesOfClass.size(), 4),
                     [&](const auto& r) {
-                        LeafWork& w = work.local();
+                        Block& block = blocks.local();
                         for (std::size_t q = r.begin(); q != r.end(); ++q) {
                             const std::size_t l = leavesOfClass[q];
                             if (!pending[l].exchange(false)) continue;
@@ -611,19 +620,19 @@ class Renormalizer {
                             for (int x = 0; x < 8; ++x)
                                 handed[x] =
                                     inbox[l * 8 + std::size_t(x)].exchange(0) & ~settled_[l][x];
-                            load(l, reach, w.block);
+                            load(l, reach, block);
                             Bits left;
-                            const Bits changed = settle(l, handed, first, reach, w, left);
+                            const Bits changed = settle(l, handed, first, reach, block, left);
                             // What a leaf could not finish waits for the next round.
                             for (int x = 0; x < 8; ++x)
                                 if (left[x]) {
                                     inbox[l * 8 + std::size_t(x)] |= left[x];
                                     pending[l] = true;
                                 }
-                            handOn(l, changed, w.block, reach, inbox.get(), pending.get());
+                            handOn(l, changed, block, reach, inbox.get(), pending.get());
                             forEachBit(changed, [&](int off) {
                                 dist_[(l << 9) + std::size_t(off)] =
-                                    w.block.side[isSet(neg_[l], off)][std::size_t(Block::at(off))];
+                                    block.side[isSet(neg_[l], off)][std::size_t(block.at(off))];
                             });
                         }
                     });
@@ -634,87 +643,66 @@ class Renormalizer {
         }
     }
 
-    // Solves the free voxels of leaf l (loaded in w.block) that have a value or were handed
-    // in, in increasing order. The order is the values' before they are solved, so a voxel
-    // may come out below one it feeds that was solved before it (a neighbour of its side with
-    // a larger value): that one is solved again in another pass, as is a voxel without a
-    // value next to one that now has one. Returns the voxels whose values moved; `left` gets
-    // the voxels still to solve after kMostPasses passes.
-    Bits settle(std::size_t l, const Bits& handed, bool first, int reach, LeafWork& w,
+    // Solves the free voxels of leaf l (loaded in `block`) until their values hold: all of
+    // them the first time the leaf is solved, later those handed in. A sweep takes the block's
+    // rows that hold voxels to solve, eight voxels at once (upwind::relaxRow), in turn forward
+    // and backward, each row reading the values of the rows before it as they now stand; the
+    // next sweep takes the voxels whose stencils read a value that moved. Returns the voxels
+    // whose values moved; `left` gets those still to solve after kMostSweeps sweeps.
+    Bits settle(std::size_t l, const Bits& handed, bool first, int reach, Block& block,
                 Bits& left) const {
-        const Bits &inside = neg_[l], &settled = settled_[l];
-        const float tolerance = kSolveTolerance * h_;
-        std::vector<ValueEntry>& order = w.order;
-        order.clear();
-        for (int x = 0; x < 8; ++x)
-            for (std::uint64_t bits = ~settled[std::size_t(x)]; bits; bits &= bits - 1) {
-                const int off = x * 64 + __builtin_ctzll(bits);
-                const float u = w.block.side[isSet(inside, off)][std::size_t(Block::at(off))];
-                if ((first && u < kInf) || isSet(handed, off)) order.push_back(valueEntry(u, off));
-            }
-        Bits changed{};
-        Bits valued = sources_[l]; // voxels with a value, whose neighbours may get one
-        for (int pass = 0; !order.empty() && pass < kMostPasses; ++pass) {
-            sortByValue(order, w.scratch, bg_);
-            Bits queued{}, done{}, again{};
-            float front = 0.0f; // the largest value solved in this pass
-            for (const ValueEntry e : order)
-                set(queued, entryOffset(e));
-            for (const ValueEntry e : order) {
-                const int off = entryOffset(e);
-                const bool side = isSet(inside, off);
-                float* v = w.block.side[side].data();
-                const int b = Block::at(off);
-                float u = reach == 2 ? secondOrder(v, b) : firstOrder(v, b);
-                if (u > bg_) u = kInf; // beyond the band
-                set(done, off);
-                const float was = v[b];
-                const bool moved = u == kInf ? was != kInf : std::abs(u - was) > tolerance;
-                if (moved) {
-                    v[b] = u;
-                    set(changed, off);
-                }
-                const float now = v[b];
-                if (now < kInf) set(valued, off);
-                // The first pass holds every voxel with a value, in order: only a value below
-                // one solved before it can feed a voxel out of order there. Later passes hold
-                // only what was handed in or solved out of order, and pass changes on.
-                if (moved && (!first || pass > 0 || was == kInf || std::min(u, was) < front)) {
-                    const float low = std::min(u, was);
-                    for (int a = 0; a < 3; ++a) {
-                        const int shift = 6 - 3 * a;
-                        for (const int dir : {-1, 1})
-                            for (int step = 1; step <= reach; ++step) {
-                                const int c = ((off >> shift) & 7) + dir * step;
-                                if (c < 0 || c > 7) break;
-                                const int n = off + dir * step * (1 << shift);
-                                if (isSet(inside, n) != side) break; // it reads its side only
-                                if (!isSet(settled, n) && (isSet(done, n) || !isSet(queued, n)) &&
-                                    v[Block::at(n)] > low)
-                                    set(again, n);
-                            }
-                    }
-                }
-                if (now < kInf) front = std::max(front, now);
-            }
-            // Voxels without a value next to one with a value, that this pass did not solve.
-            const Bits in = grown(valued & inside) & inside;
-            const Bits out = grown(valued & ~inside) & ~inside;
-            forEachBit((in | out) & ~settled & ~queued, [&](int off) {
-                if (w.block.side[isSet(inside, off)][std::size_t(Block::at(off))] == kInf)
-                    set(again, off);
-            });
-            valued = Bits{};
-            order.clear();
-            forEachBit(again, [&](int off) {
-                order.push_back(
-                    valueEntry(w.block.side[isSet(inside, off)][std::size_t(Block::at(off))], off));
-            });
-        }
+        // Voxel sets in the block's order (readers() treats every axis alike).
+        const int axis = block.rowAxis;
+        const Bits inside = inBlockOrder(neg_[l], axis),
+                   solvable = inBlockOrder(~settled_[l], axis);
+        upwind::RowBlock rows[2];
+        for (int side = 0; side < 2; ++side)
+            rows[side] = {block.side[std::size_t(side)].data(),
+                          Block::kStride[0],
+                          Block::kStride[1],
+                          h_,
+                          bg_,
+                          kSolveTolerance * h_,
+                          reach};
+        Bits todo = first ? solvable : inBlockOrder(handed, axis) & solvable, changed{};
         left = Bits{};
-        for (const ValueEntry e : order)
-            set(left, entryOffset(e));
-        return changed;
+        for (int sweep = 0; sweep < kMostSweeps; ++sweep) {
+            Bits moved{};
+            bool anyMoved = false;
+            // The directions of this sweep: the leaf's first ones, then both reversed, then
+            // each in turn (the four orders of fast sweeping in the plane across the rows).
+            constexpr unsigned kTurn[4] = {0u, 3u, 1u, 2u};
+            const unsigned outward = (unsigned(layout_[l]) >> 2 ^ kTurn[sweep % 4]) & 3u;
+            // The two sides' rows in turn: their updates do not depend on each other, so one
+            // row's chain of operations overlaps the other's.
+            for (int r = 0; r < 64; ++r)
+                for (int side = 0; side < 2; ++side) {
+                    const unsigned flip = side ? outward ^ 3u : outward;
+                    const int i = flip & 1u ? 7 - (r >> 3) : r >> 3;
+                    const int j = flip & 2u ? 7 - (r & 7) : r & 7, shift = 8 * j;
+                    const unsigned lanes =
+                        unsigned((side ? inside[std::size_t(i)] : ~inside[std::size_t(i)]) >>
+                                 shift) &
+                        0xffu;
+                    const unsigned want = unsigned(todo[std::size_t(i)] >> shift) & lanes;
+                    if (!want) continue;
+                    const unsigned free = unsigned(solvable[std::size_t(i)] >> shift) & lanes;
+                    constexpr int R = Block::kRim;
+                    const int b = (i + R) * Block::kStride[0] + (j + R) * Block::kStride[1] + R;
+                    // The whole row of the side: its other solvable voxels read the same values.
+                    const unsigned m = upwind::relaxRow(rows[side], b, free);
+                    moved[std::size_t(i)] |= std::uint64_t(m) << shift;
+                    anyMoved |= m != 0;
+                }
+            if (!anyMoved) {
+                todo = Bits{};
+                break;
+            }
+            changed = changed | moved;
+            todo = readers(moved, reach) & solvable;
+        }
+        left = any(todo) ? inBlockOrder(todo, axis) : Bits{};
+        return inBlockOrder(changed, axis);
     }
 
     // Hands to l's neighbours the voxels whose stencils may read a voxel of l that changed:
@@ -728,7 +716,7 @@ class Renormalizer {
         std::array<Bits, 6> into{};
         forEachBit(changed, [&](int off) {
             const bool side = isSet(neg_[l], off);
-            const float low = std::min(block.side[side][std::size_t(Block::at(off))],
+            const float low = std::min(block.side[side][std::size_t(block.at(off))],
                                        dist_[(l << 9) + std::size_t(off)]);
             forEachAxis([&](auto a) {
                 constexpr int shift = 6 - 3 * decltype(a)::value;
@@ -818,9 +806,8 @@ class Renormalizer {
     // Per leaf: the inactive voxels next to free ones, free so that the band can grow into
     // them.
     std::vector<Bits> beyond_;
-    // Per leaf: the settled voxels close enough to the surface to bring a neighbour into the
-    // band (set before the solve).
-    std::vector<Bits> sources_;
+    // Per leaf: how its block is laid out and swept (layoutOf).
+    std::vector<std::uint8_t> layout_;
 };
 
 FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,

@@ -13,7 +13,6 @@
 #include "grids.h"
 #include "levelset/band.h"
 #include "levelset/fast_marching.h"
-#include "levelset/value_order.h"
 
 using namespace sweepers;
 using sweepers::test::gridFromSdf;
@@ -219,32 +218,6 @@ TEST(FastMarching, ThinRodSurvivesManyRenormalizations) {
     std::printf("[ fmm ] rod volume %.6g -> %.6g after 100 renormalizations (%+.2f%%)\n", v0, v1,
                 100 * (v1 - v0) / v0);
     EXPECT_NEAR(v1, v0, 0.05 * v0);
-}
-
-// The solve takes a leaf's voxels in the order of sortByValue: the same as std::sort's for
-// values spread over the band, tied, beyond it and infinite.
-TEST(FastMarching, VoxelsAreSortedByValueThenOffset) {
-    std::mt19937 random(7);
-    const float bound = 0.0234f, inf = std::numeric_limits<float>::infinity();
-    std::uniform_real_distribution<float> inBand(0.0f, bound);
-    std::uniform_int_distribution<int> offset(0, 511), kind(0, 19);
-    std::vector<ValueEntry> scratch;
-    for (int trial = 0; trial < 200; ++trial) {
-        std::vector<ValueEntry> entries;
-        const int n = 1 + trial % 300;
-        for (int i = 0; i < n; ++i) {
-            const int k = kind(random);
-            const float v = k == 0   ? inf
-                            : k == 1 ? bound * (1.0f + inBand(random)) // past the bound
-                            : k == 2 ? 0.01f                           // ties
-                                     : inBand(random);
-            entries.push_back(valueEntry(v, offset(random)));
-        }
-        std::vector<ValueEntry> expected = entries;
-        std::sort(expected.begin(), expected.end());
-        sortByValue(entries, scratch, bound);
-        ASSERT_EQ(entries, expected) << "trial " << trial;
-    }
 }
 
 // The leaves of one class are solved at once, so no two of them may share a face (a leaf

@@ -1,0 +1,21 @@
+// The upwind update of renormalization for a row of eight voxels at once (eight lanes of
+// vector registers): the row along z of a leaf, in a dense block of one side's distances
+// where the other side's voxels read as +infinity.
+#pragma once
+
+namespace sweepers::upwind {
+
+struct RowBlock {
+    float* values;        // one side's distances, +infinity where none (or the other side)
+    int strideX, strideY; // of the block (z is 1)
+    float h, background;  // the voxel size; values past the background are +infinity
+    float tolerance;      // a value that moves by less is left as it was
+    int reach;            // 1: first-order stencils, 2: second order where it is upwind
+};
+
+// Solves the upwind equations at the lanes of the row starting at block index b that are
+// set in `lanes` (bit z for the voxel at b + z), from the values around them as they stand,
+// and writes the values that moved by more than the tolerance. Returns those lanes.
+unsigned relaxRow(const RowBlock& block, int b, unsigned lanes);
+
+} // namespace sweepers::upwind
