@@ -10,6 +10,7 @@
 #include <tbb/parallel_sort.h>
 #include <xxhash.h>
 
+#include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
 #include "levelset/stencils.h"
 #include "mesh/mc_table.h"
@@ -55,19 +56,36 @@ class LeafBlock {
         return values_[((l.x() + 1) * kSpan + l.y() + 1) * kSpan + l.z() + 1];
     }
 
-    // Whether all the cubes' corners (the leaf and one voxel past its upper faces) lie on
-    // one side of the surface: then none of its cubes crosses it.
-    bool oneSign() const {
-        bool any = false, all = true;
-        for (int x = 1; x <= kDim + 1; ++x)
-            for (int y = 1; y <= kDim + 1; ++y) {
-                const float* row = &values_[(std::size_t(x) * kSpan + std::size_t(y)) * kSpan + 1];
-                for (int z = 0; z <= kDim; ++z) {
-                    any |= row[z] < 0.0f;
-                    all &= row[z] < 0.0f;
-                }
+    // The cubes the surface crosses (those with corners of both signs), as a voxel set of
+    // the leaf: the cube of voxel (x, y, z) has its corners from there to (x + 1, y + 1,
+    // z + 1), one voxel past the leaf's upper faces. Found a row of eight cubes along z at a
+    // time, from the signs of the four rows of corners around it (one compare per corner,
+    // where testing each cube read its eight corners).
+    leafwords::Words crossingCubes() const {
+        std::array<unsigned, (kDim + 1) * (kDim + 1)> negative; // per corner row, bit z
+        for (int x = 0; x <= kDim; ++x)
+            for (int y = 0; y <= kDim; ++y) {
+                const float* row =
+                    &values_[(std::size_t(x + 1) * kSpan + std::size_t(y + 1)) * kSpan + 1];
+                unsigned bits = 0;
+                for (int z = 0; z <= kDim; ++z)
+                    bits |= unsigned(row[z] < 0.0f) << z;
+                negative[std::size_t(x * (kDim + 1) + y)] = bits;
             }
-        return any == all;
+        leafwords::Words out{};
+        for (int x = 0; x < kDim; ++x)
+            for (int y = 0; y < kDim; ++y) {
+                unsigned allNegative = 0xffu, allPositive = 0xffu;
+                for (int c = 0; c < 4; ++c) {
+                    const unsigned r =
+                        negative[std::size_t((x + (c & 1)) * (kDim + 1) + y + (c >> 1))];
+                    allNegative &= r & r >> 1;
+                    allPositive &= ~r & ~r >> 1;
+                }
+                out[std::size_t(x)] |= leafwords::Word(~(allNegative | allPositive) & 0xffu)
+                                       << (8 * y);
+            }
+        return out;
     }
 
     // A hash of the values, the leaf's active voxels and where the grid puts its voxels:
@@ -149,8 +167,13 @@ class LeafVertices {
 bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) {
     const Grid::TreeType::LeafNodeType* leaf = grid.tree().probeConstLeaf(origin);
     std::optional<LeafBlock> block;
-    if (leaf) block.emplace(grid.getConstAccessor(), *leaf);
-    if (!leaf || block->oneSign()) { // no surface
+    leafwords::Words crossing{};
+    if (leaf) {
+        block.emplace(grid.getConstAccessor(), *leaf);
+        crossing = block->crossingCubes();
+    }
+    if (std::all_of(crossing.begin(), crossing.end(), [](leafwords::Word w) { return w == 0; })) {
+        // No surface: every corner on one side.
         const bool had = chunk.madeFrom != 0;
         chunk = MeshChunk{};
         return had;
@@ -169,73 +192,79 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) 
     thread_local LeafVertices vertices;
     vertices.clear();
     auto gradient = [&](const openvdb::Coord& c) { return centralGradient(acc, c, h); };
-    for (auto it = leaf->cbeginValueOn(); it; ++it) {
-        const openvdb::Coord base = it.getCoord();
-        float v[8];
-        int mask = 0;
-        for (int c = 0; c < 8; ++c) {
-            v[c] = acc.getValue(cubeCorner(base, c));
-            if (v[c] < 0.0f) mask |= 1 << c;
-        }
-        if (mask == 0 || mask == 255) continue;
-        // The vertex on cube edge e, created on first use.
-        auto vertexOn = [&](int e) {
-            const mc::Edge& edge = mc::kEdges[e];
-            const openvdb::Coord c0 =
-                base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
-            int& id = vertices.onEdge(c0 - origin, edge.axis);
-            if (id < 0) {
-                id = int(chunk.positions.size());
-                // A crossing never sits on a voxel itself (a value of exactly zero there, or a
-                // division that rounds): every edge through that voxel would put its own
-                // vertex at the same point, and the triangles between them would have no
-                // area. A thousandth of a voxel along the edge keeps them apart.
-                constexpr float kOffVoxel = 1e-3f;
-                const float a = v[edge.c0], b = v[edge.c1];
-                const float t = std::clamp(a / (a - b), kOffVoxel, 1.0f - kOffVoxel);
-                openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
-                p[edge.axis] += t;
-                const openvdb::Vec3d w = xform.indexToWorld(p);
-                chunk.positions.emplace_back(float(w.x()), float(w.y()), float(w.z()));
-                openvdb::Coord c1 = c0;
-                c1[edge.axis] += 1;
-                const Eigen::Vector3f n = (1 - t) * gradient(c0) + t * gradient(c1);
-                const float len = n.norm();
-                chunk.normals.push_back(len > 0 ? Eigen::Vector3f(n / len)
-                                                : Eigen::Vector3f(0, 0, 1));
-                chunk.edgeKeys.push_back(makeKey(c0, edge.axis));
+    // The cubes of the leaf's active voxels that the surface crosses, in offset order.
+    for (int x = 0; x < 8; ++x)
+        for (leafwords::Word w =
+                 crossing[std::size_t(x)] & leaf->getValueMask().getWord<leafwords::Word>(x);
+             w; w &= w - 1) {
+            const openvdb::Coord base =
+                leaf->offsetToGlobalCoord(openvdb::Index(x * 64 + __builtin_ctzll(w)));
+            float v[8];
+            int mask = 0;
+            for (int c = 0; c < 8; ++c) {
+                v[c] = acc.getValue(cubeCorner(base, c));
+                if (v[c] < 0.0f) mask |= 1 << c;
             }
-            return id;
-        };
-        const mc::Case& cube = mc::lookup(mask);
-        int ids[3];
-        for (const auto& tri : cube.triangles) {
-            for (int k = 0; k < 3; ++k) {
-                const int e = tri[k];
-                if (e >= mc::kCentre) {
-                    // A cycle's centre: never shared with another cube.
-                    const int cycle = e - mc::kCentre;
-                    int& id = vertices.atCentre(base - origin, cycle);
-                    if (id < 0) {
-                        Eigen::Vector3f p = Eigen::Vector3f::Zero(), nrm = Eigen::Vector3f::Zero();
-                        for (std::uint8_t ce : cube.cycles[cycle]) {
-                            const int vi = vertexOn(ce);
-                            p += chunk.positions[vi];
-                            nrm += chunk.normals[vi];
-                        }
-                        id = int(chunk.positions.size());
-                        chunk.positions.push_back(p / float(cube.cycles[cycle].size()));
-                        chunk.normals.push_back(nrm.normalized());
-                        chunk.edgeKeys.push_back(makeKey(base, 3) | (std::uint64_t(cycle) << 62));
-                    }
-                    ids[k] = id;
-                } else {
-                    ids[k] = vertexOn(e);
+            // The vertex on cube edge e, created on first use.
+            auto vertexOn = [&](int e) {
+                const mc::Edge& edge = mc::kEdges[e];
+                const openvdb::Coord c0 =
+                    base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
+                int& id = vertices.onEdge(c0 - origin, edge.axis);
+                if (id < 0) {
+                    id = int(chunk.positions.size());
+                    // A crossing never sits on a voxel itself (a value of exactly zero there, or a
+                    // division that rounds): every edge through that voxel would put its own
+                    // vertex at the same point, and the triangles between them would have no
+                    // area. A thousandth of a voxel along the edge keeps them apart.
+                    constexpr float kOffVoxel = 1e-3f;
+                    const float a = v[edge.c0], b = v[edge.c1];
+                    const float t = std::clamp(a / (a - b), kOffVoxel, 1.0f - kOffVoxel);
+                    openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
+                    p[edge.axis] += t;
+                    const openvdb::Vec3d w = xform.indexToWorld(p);
+                    chunk.positions.emplace_back(float(w.x()), float(w.y()), float(w.z()));
+                    openvdb::Coord c1 = c0;
+                    c1[edge.axis] += 1;
+                    const Eigen::Vector3f n = (1 - t) * gradient(c0) + t * gradient(c1);
+                    const float len = n.norm();
+                    chunk.normals.push_back(len > 0 ? Eigen::Vector3f(n / len)
+                                                    : Eigen::Vector3f(0, 0, 1));
+                    chunk.edgeKeys.push_back(makeKey(c0, edge.axis));
                 }
+                return id;
+            };
+            const mc::Case& cube = mc::lookup(mask);
+            int ids[3];
+            for (const auto& tri : cube.triangles) {
+                for (int k = 0; k < 3; ++k) {
+                    const int e = tri[k];
+                    if (e >= mc::kCentre) {
+                        // A cycle's centre: never shared with another cube.
+                        const int cycle = e - mc::kCentre;
+                        int& id = vertices.atCentre(base - origin, cycle);
+                        if (id < 0) {
+                            Eigen::Vector3f p = Eigen::Vector3f::Zero(),
+                                            nrm = Eigen::Vector3f::Zero();
+                            for (std::uint8_t ce : cube.cycles[cycle]) {
+                                const int vi = vertexOn(ce);
+                                p += chunk.positions[vi];
+                                nrm += chunk.normals[vi];
+                            }
+                            id = int(chunk.positions.size());
+                            chunk.positions.push_back(p / float(cube.cycles[cycle].size()));
+                            chunk.normals.push_back(nrm.normalized());
+                            chunk.edgeKeys.push_back(makeKey(base, 3) |
+                                                     (std::uint64_t(cycle) << 62));
+                        }
+                        ids[k] = id;
+                    } else {
+                        ids[k] = vertexOn(e);
+                    }
+                }
+                chunk.triangles.emplace_back(ids[0], ids[1], ids[2]);
             }
-            chunk.triangles.emplace_back(ids[0], ids[1], ids[2]);
         }
-    }
     chunk.volume = enclosedVolume(chunk.positions, chunk.triangles);
     return true;
 }
