@@ -208,51 +208,72 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
     tbb::enumerable_thread_specific<SourceBlock> blocks;
+    // Grids from create.cpp place voxels by a scale and a translation: through that map's
+    // own (final) functions, a voxel's position costs no virtual call.
+    const auto* scaled =
+        dynamic_cast<const openvdb::math::ScaleTranslateMap*>(xform.baseMap().get());
+    const auto toWorld = [&](const openvdb::Vec3d& ijk) {
+        return scaled ? scaled->applyMap(ijk) : xform.indexToWorld(ijk);
+    };
+    const auto toIndex = [&](const openvdb::Vec3d& p) {
+        return scaled ? scaled->applyInverseMap(p) : xform.worldToIndex(p);
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
         const SampleSource::Accessor acc(source);
         SourceBlock& block = blocks.local();
         std::size_t n = 0;
         pollInterrupt(interrupter);
         for (std::size_t l = range.begin(); l != range.end(); ++l) {
+            LeafNode& leaf = *leaves[l];
             bool filled = false; // the block is filled for the leaf's first sample
             // The leaf as the source holds it (a copy: sampling writes this one), to tell
             // which voxels the band grew into.
-            const LeafNode* before = acc.leafAt(leaves[l]->origin());
+            const LeafNode* before = acc.leafAt(leaf.origin());
             // With `only`, just the active voxels it holds are sampled.
-            const auto* wanted = only ? only->probeConstLeaf(leaves[l]->origin()) : nullptr;
+            const auto* wanted = only ? only->probeConstLeaf(leaf.origin()) : nullptr;
             if (only && !wanted) continue;
-            for (auto it = leaves[l]->beginValueOn(); it; ++it) {
-                const openvdb::Coord ijk = it.getCoord();
-                if (!box.isInside(ijk) || (wanted && !wanted->isValueOn(it.pos()))) continue;
-                const Eigen::Vector3d x = toEigen(xform.indexToWorld(ijk));
-                const Eigen::Vector3d y = map(x);
-                float v = *it;
-                if (y != x || !sourceIsGrid) {
-                    const auto sample = [&](const Eigen::Vector3d& at) {
-                        const openvdb::Vec3d p = xform.worldToIndex(toVdb(at));
-                        if (sampling != Sampling::Trilinear)
-                            return float(sampleMonotoneCubic(acc, p));
-                        const openvdb::Coord cell(openvdb::tools::local_util::floorVec3(p));
-                        if (!filled) {
-                            block.fill(acc, leaves[l]->origin());
-                            filled = true;
+            const leafwords::Words inBox = leafwords::inBox(box, leaf.origin());
+            float* values = leaf.buffer().data();
+            for (int wx = 0; wx < 8; ++wx) {
+                leafwords::Word word =
+                    leaf.getValueMask().getWord<leafwords::Word>(wx) & inBox[std::size_t(wx)];
+                if (wanted) word &= wanted->getValueMask().getWord<leafwords::Word>(wx);
+                for (; word; word &= word - 1) {
+                    const int bit = __builtin_ctzll(word), pos = wx * 64 + bit;
+                    const openvdb::Coord ijk = leaf.origin().offsetBy(wx, bit >> 3, bit & 7);
+                    const Eigen::Vector3d x = toEigen(toWorld(ijk.asVec3d()));
+                    const Eigen::Vector3d y = map(x);
+                    const float old = values[pos];
+                    float v = old;
+                    if (y != x || !sourceIsGrid) {
+                        const auto sample = [&](const Eigen::Vector3d& at) {
+                            const openvdb::Vec3d p = toIndex(toVdb(at));
+                            if (sampling != Sampling::Trilinear)
+                                return float(sampleMonotoneCubic(acc, p));
+                            const openvdb::Coord cell(openvdb::tools::local_util::floorVec3(p));
+                            if (!filled) {
+                                block.fill(acc, leaf.origin());
+                                filled = true;
+                            }
+                            return block.holds(cell) ? block.trilinear(cell, p - cell.asVec3d())
+                                                     : acc.trilinear(p);
+                        };
+                        v = sample(y);
+                        const double depth = tearing ? tearing->openedDepth(x) : 0.0;
+                        if (depth > 0.0) {
+                            const Eigen::Vector3d along =
+                                tearing->alongTorn(x) * (0.5 * tornWindow);
+                            for (int t = -2; t <= 2; ++t)
+                                if (t != 0) v = std::max(v, sample(y + double(t) * along));
+                            v += float(depth);
                         }
-                        return block.holds(cell) ? block.trilinear(cell, p - cell.asVec3d())
-                                                 : acc.trilinear(p);
-                    };
-                    v = sample(y);
-                    const double depth = tearing ? tearing->openedDepth(x) : 0.0;
-                    if (depth > 0.0) {
-                        const Eigen::Vector3d along = tearing->alongTorn(x) * (0.5 * tornWindow);
-                        for (int t = -2; t <= 2; ++t)
-                            if (t != 0) v = std::max(v, sample(y + double(t) * along));
-                        v += float(depth);
                     }
+                    if (v != old ||
+                        !(before ? before->isValueOn(openvdb::Index(pos)) : acc.isValueOn(ijk)))
+                        changedWords[l][std::size_t(wx)] |= leafwords::Word(1) << bit;
+                    values[pos] = v;
+                    ++n;
                 }
-                if (v != *it || !(before ? before->isValueOn(it.pos()) : acc.isValueOn(ijk)))
-                    changedWords[l][it.pos() >> 6] |= std::uint64_t(1) << (it.pos() & 63);
-                it.setValue(v);
-                ++n;
             }
         }
         count += n;
