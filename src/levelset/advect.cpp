@@ -208,16 +208,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
     tbb::enumerable_thread_specific<SourceBlock> blocks;
-    // Grids from create.cpp place voxels by a scale and a translation: through that map's
-    // own (final) functions, a voxel's position costs no virtual call.
-    const auto* scaled =
-        dynamic_cast<const openvdb::math::ScaleTranslateMap*>(xform.baseMap().get());
-    const auto toWorld = [&](const openvdb::Vec3d& ijk) {
-        return scaled ? scaled->applyMap(ijk) : xform.indexToWorld(ijk);
-    };
-    const auto toIndex = [&](const openvdb::Vec3d& p) {
-        return scaled ? scaled->applyInverseMap(p) : xform.worldToIndex(p);
-    };
+    const VoxelPlacement place(xform);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
         const SampleSource::Accessor acc(source);
         SourceBlock& block = blocks.local();
@@ -241,13 +232,13 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                 for (; word; word &= word - 1) {
                     const int bit = __builtin_ctzll(word), pos = wx * 64 + bit;
                     const openvdb::Coord ijk = leaf.origin().offsetBy(wx, bit >> 3, bit & 7);
-                    const Eigen::Vector3d x = toEigen(toWorld(ijk.asVec3d()));
+                    const Eigen::Vector3d x = toEigen(place.toWorld(ijk.asVec3d()));
                     const Eigen::Vector3d y = map(x);
                     const float old = values[pos];
                     float v = old;
                     if (y != x || !sourceIsGrid) {
                         const auto sample = [&](const Eigen::Vector3d& at) {
-                            const openvdb::Vec3d p = toIndex(toVdb(at));
+                            const openvdb::Vec3d p = place.toIndex(toVdb(at));
                             if (sampling != Sampling::Trilinear)
                                 return float(sampleMonotoneCubic(acc, p));
                             const openvdb::Coord cell(openvdb::tools::local_util::floorVec3(p));
@@ -489,18 +480,19 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     stats.interfaceVoxels = interface.size();
     // Each thread marks the images in a mask of its own; the masks are merged after.
     tbb::enumerable_thread_specific<openvdb::MaskTree> marks;
+    const VoxelPlacement place(grid.transform());
     tbb::enumerable_thread_specific<double> stretch(1.0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
         pollInterrupt(options.interrupter);
         openvdb::tree::ValueAccessor<openvdb::MaskTree, false> m(marks.local());
         double& worst = stretch.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            Eigen::Vector3d p = toEigen(grid.indexToWorld(interface[i]));
+            Eigen::Vector3d p = toEigen(place.toWorld(interface[i].asVec3d()));
             for (int k = 0; k < seg.steps(); ++k) {
                 p = seg.forwardStep(k, p, forwardTolerance).p;
                 // Intermediate surfaces only need a band when they are stored.
                 if (options.resampleEachSubStep || k + 1 == seg.steps())
-                    m.setValueOn(openvdb::Coord::round(grid.worldToIndex(toVdb(p))));
+                    m.setValueOn(openvdb::Coord::round(place.toIndex(toVdb(p))));
             }
             if (i % kStretchSampling != 0) continue;
             // How far the inverse map can spread a voxel-sized neighbourhood of the new

@@ -20,6 +20,27 @@ inline openvdb::Vec3d toVdb(const Eigen::Vector3d& v) {
     return {v.x(), v.y(), v.z()};
 }
 
+// Where a grid puts its voxels, for loops that place many: the grids this program makes
+// place them by a scale and a translation, whose map's functions are final (so they inline
+// here, where the transform's own calls are virtual); any other map goes through the
+// transform.
+class VoxelPlacement {
+  public:
+    explicit VoxelPlacement(const openvdb::math::Transform& xform)
+        : xform_(xform),
+          scaled_(dynamic_cast<const openvdb::math::ScaleTranslateMap*>(xform.baseMap().get())) {}
+    openvdb::Vec3d toWorld(const openvdb::Vec3d& ijk) const {
+        return scaled_ ? scaled_->applyMap(ijk) : xform_.indexToWorld(ijk);
+    }
+    openvdb::Vec3d toIndex(const openvdb::Vec3d& p) const {
+        return scaled_ ? scaled_->applyInverseMap(p) : xform_.worldToIndex(p);
+    }
+
+  private:
+    const openvdb::math::Transform& xform_;
+    const openvdb::math::ScaleTranslateMap* scaled_;
+};
+
 // Half-width of a level set's band in voxels, from its background value.
 // The background is a float: background / voxel size misses the half-width set by a unit or
 // so in the seventh digit (2.99999993 voxels at voxel size 0.01), and a band widened by

@@ -187,7 +187,7 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) 
     chunk.volume = 0.0;
     chunk.madeFrom = madeFrom;
     const LeafBlock& acc = *block;
-    const auto& xform = grid.transform();
+    const VoxelPlacement place(grid.transform());
     const double h = grid.voxelSize()[0];
     thread_local LeafVertices vertices;
     vertices.clear();
@@ -222,7 +222,7 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) 
                     const float t = std::clamp(a / (a - b), kOffVoxel, 1.0f - kOffVoxel);
                     openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
                     p[edge.axis] += t;
-                    const openvdb::Vec3d w = xform.indexToWorld(p);
+                    const openvdb::Vec3d w = place.toWorld(p);
                     chunk.positions.emplace_back(float(w.x()), float(w.y()), float(w.z()));
                     openvdb::Coord c1 = c0;
                     c1[edge.axis] += 1;
