@@ -204,7 +204,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                      const openvdb::MaskTree* only = nullptr) {
     // Per leaf, the voxels whose value changed (a word per x, as the leaf's mask holds them):
     // written by the leaf's own task, then merged into `changed` a leaf at a time.
-    std::vector<std::array<std::uint64_t, 8>> changedWords(leaves.size());
+    std::vector<leafwords::Words> changedWords(leaves.size());
     std::atomic<std::size_t> count{0};
     const auto& xform = grid.transform();
     tbb::enumerable_thread_specific<SourceBlock> blocks;
@@ -271,8 +271,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     });
     for (std::size_t l = 0; l < leaves.size(); ++l) {
         const auto& words = changedWords[l];
-        if (std::all_of(words.begin(), words.end(), [](std::uint64_t w) { return w == 0; }))
-            continue;
+        if (!leafwords::any(words)) continue;
         auto& mask = changed.tree().touchLeaf(leaves[l]->origin())->getValueMask();
         for (int x = 0; x < 8; ++x)
             mask.getWord<std::uint64_t>(x) |= words[std::size_t(x)];

@@ -201,13 +201,6 @@ leafwords::Word nonzeroBytes(leafwords::Word w) {
     return w & leafwords::kZ0;
 }
 
-bool any(const Bits& bits) {
-    leafwords::Word all = 0;
-    for (const leafwords::Word w : bits)
-        all |= w;
-    return all != 0;
-}
-
 bool isSet(const Bits& bits, int off) {
     return (bits[std::size_t(off) >> 6] >> (off & 63)) & 1;
 }
@@ -744,7 +737,7 @@ class Renormalizer {
             changed = changed | moved;
             todo = readers(moved, reach) & solvable;
         }
-        left = any(todo) ? inBlockOrder(todo, axis) : Bits{};
+        left = leafwords::any(todo) ? inBlockOrder(todo, axis) : Bits{};
         return inBlockOrder(changed, axis);
     }
 

@@ -16,6 +16,14 @@ using Words = std::array<Word, 8>;                          // a set of one leaf
 constexpr Word kZ0 = 0x0101010101010101ull, kZ7 = kZ0 << 7; // the voxels at z = 0, z = 7
 constexpr Word kY0 = 0xffull, kY7 = kY0 << 56;              // the voxels at y = 0, y = 7
 
+// Whether the set holds any voxel.
+inline bool any(const Words& set) {
+    Word all = 0;
+    for (const Word w : set)
+        all |= w;
+    return all != 0;
+}
+
 // Word x of the set `own` seen one step along axis A (dir = +-1): its bit for a voxel is the
 // bit of the voxel one step away. Past the leaf's face it reads `facing`, the layer of the
 // next leaf that faces it, laid out as that axis needs it: along x the whole word, along y

@@ -1,13 +1,13 @@
 // The upwind update of renormalization for a row of eight voxels at once (eight lanes of
-// vector registers): the row along z of a leaf, in a dense block of one side's distances
-// where the other side's voxels read as +infinity.
+// vector registers): a row of a dense block of one side's distances (along the block's axis
+// of stride 1), where the other side's voxels read as +infinity.
 #pragma once
 
 namespace sweepers::upwind {
 
 struct RowBlock {
     float* values;        // one side's distances, +infinity where none (or the other side)
-    int strideX, strideY; // of the block (z is 1)
+    int strideX, strideY; // of the block's other two axes (its rows have stride 1)
     float h, background;  // the voxel size; values past the background are +infinity
     float tolerance;      // a value that moves by less is left as it was
     int reach;            // 1: first-order stencils, 2: second order where it is upwind

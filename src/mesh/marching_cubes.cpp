@@ -172,7 +172,7 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) 
         block.emplace(grid.getConstAccessor(), *leaf);
         crossing = block->crossingCubes();
     }
-    if (std::all_of(crossing.begin(), crossing.end(), [](leafwords::Word w) { return w == 0; })) {
+    if (!leafwords::any(crossing)) {
         // No surface: every corner on one side.
         const bool had = chunk.madeFrom != 0;
         chunk = MeshChunk{};
