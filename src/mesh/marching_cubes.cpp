@@ -62,28 +62,26 @@ class LeafBlock {
     // time, from the signs of the four rows of corners around it (one compare per corner,
     // where testing each cube read its eight corners).
     leafwords::Words crossingCubes() const {
-        std::array<unsigned, (kDim + 1) * (kDim + 1)> negative; // per corner row, bit z
-        for (int x = 0; x <= kDim; ++x)
-            for (int y = 0; y <= kDim; ++y) {
-                const float* row =
-                    &values_[(std::size_t(x + 1) * kSpan + std::size_t(y + 1)) * kSpan + 1];
+        constexpr std::size_t kRows = kDim + 1;       // corner rows along x and along y
+        std::array<unsigned, kRows * kRows> negative; // per corner row, bit z
+        for (std::size_t x = 0; x < kRows; ++x)
+            for (std::size_t y = 0; y < kRows; ++y) {
+                const float* row = &values_[((x + 1) * kSpan + (y + 1)) * kSpan + 1];
                 unsigned bits = 0;
                 for (int z = 0; z <= kDim; ++z)
                     bits |= unsigned(row[z] < 0.0f) << z;
-                negative[std::size_t(x * (kDim + 1) + y)] = bits;
+                negative[x * kRows + y] = bits;
             }
         leafwords::Words out{};
-        for (int x = 0; x < kDim; ++x)
-            for (int y = 0; y < kDim; ++y) {
+        for (std::size_t x = 0; x < kDim; ++x)
+            for (std::size_t y = 0; y < kDim; ++y) {
                 unsigned allNegative = 0xffu, allPositive = 0xffu;
-                for (int c = 0; c < 4; ++c) {
-                    const unsigned r =
-                        negative[std::size_t((x + (c & 1)) * (kDim + 1) + y + (c >> 1))];
+                for (std::size_t c = 0; c < 4; ++c) {
+                    const unsigned r = negative[(x + (c & 1)) * kRows + y + (c >> 1)];
                     allNegative &= r & r >> 1;
                     allPositive &= ~r & ~r >> 1;
                 }
-                out[std::size_t(x)] |= leafwords::Word(~(allNegative | allPositive) & 0xffu)
-                                       << (8 * y);
+                out[x] |= leafwords::Word(~(allNegative | allPositive) & 0xffu) << (8 * y);
             }
         return out;
     }
