@@ -18,4 +18,12 @@ struct RowBlock {
 // and writes the values that moved by more than the tolerance. Returns those lanes.
 unsigned relaxRow(const RowBlock& block, int b, unsigned lanes);
 
+namespace detail {
+// The two ways relaxRow has of doing it (the same values, to the bit): four lanes at a time,
+// twice, on any CPU, and eight at once with AVX2 (hasAvx2(); elsewhere the four-lane way).
+unsigned relaxRowIn4s(const RowBlock& block, int b, unsigned lanes);
+unsigned relaxRowIn8s(const RowBlock& block, int b, unsigned lanes);
+bool hasAvx2();
+} // namespace detail
+
 } // namespace sweepers::upwind

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <utility>
@@ -13,6 +14,7 @@
 #include "grids.h"
 #include "levelset/band.h"
 #include "levelset/fast_marching.h"
+#include "levelset/upwind_row.h"
 
 using namespace sweepers;
 using sweepers::test::gridFromSdf;
@@ -250,4 +252,37 @@ TEST(FastMarching, OneThreadAndTwoGiveTheSameBand) {
         EXPECT_EQ(one->tree().leafCount(), two->tree().leafCount());
         EXPECT_EQ(differ, 0u) << "run " << run;
     }
+}
+
+// relaxRow takes four lanes at a time on any CPU and eight at once with AVX2: both give the
+// same values and the same moved lanes, to the bit, with either stencil. (Both halves of a
+// row are solved from the row as it was: a half written before the other was solved would
+// feed it new values.)
+TEST(FastMarching, RowUpdatesAreTheSameInFourLanesAndInEight) {
+    if (!upwind::detail::hasAvx2()) GTEST_SKIP() << "no AVX2: relaxRow has one way only";
+    std::mt19937 random(11);
+    const float h = 1.0f / 128, inf = std::numeric_limits<float>::infinity();
+    std::uniform_real_distribution<float> value(0.0f, 3.5f * h);
+    std::uniform_int_distribution<int> kind(0, 5);
+    constexpr int kDim = 12; // a block: a leaf and a rim of two voxels
+    std::vector<float> four(kDim * kDim * kDim), eight;
+    int moved = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        for (float& v : four)
+            v = kind(random) == 0 ? inf : value(random);
+        eight = four;
+        upwind::RowBlock block{four.data(), kDim * kDim, kDim,         h,
+                               3.0f * h,    1e-6f * h,   1 + trial % 2};
+        upwind::RowBlock other = block;
+        other.values = eight.data();
+        const int b = (2 + trial % 8) * kDim * kDim + (2 + trial / 8 % 8) * kDim + 2;
+        const unsigned lanes = unsigned(trial * 37) & 0xffu;
+        const unsigned inFours = upwind::detail::relaxRowIn4s(block, b, lanes);
+        const unsigned inEights = upwind::detail::relaxRowIn8s(other, b, lanes);
+        ASSERT_EQ(inFours, inEights) << "trial " << trial;
+        ASSERT_EQ(0, std::memcmp(four.data(), eight.data(), sizeof(float) * four.size()))
+            << "trial " << trial;
+        moved += __builtin_popcount(inFours);
+    }
+    EXPECT_GT(moved, 1000); // the rows moved: the blocks compared were not left as they were
 }
