@@ -206,9 +206,8 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     // written by the leaf's own task, then merged into `changed` a leaf at a time.
     std::vector<leafwords::Words> changedWords(leaves.size());
     std::atomic<std::size_t> count{0};
-    const auto& xform = grid.transform();
     tbb::enumerable_thread_specific<SourceBlock> blocks;
-    const VoxelPlacement place(xform);
+    const VoxelPlacement place(grid.transform());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
         const SampleSource::Accessor acc(source);
         SourceBlock& block = blocks.local();

@@ -107,18 +107,12 @@ class Domain {
         const Word* w = sets[l].data();
         const int nl = neighbours_[l][2 * A + (dir > 0)];
         const Word* n = nl < 0 ? nullptr : sets[std::size_t(nl)].data();
+        // The voxels whose step leaves the leaf: without a neighbour in the domain they have
+        // none.
+        const Words leaving = nearFace<A>(dir, 1);
         for (int x = 0; x < 8; ++x) {
             out[x] = leafwords::stepped<A>(w, x, dir, n ? facing<A>(n, x, dir) : 0);
-            // The voxels whose step leaves the leaf: without a neighbour in the domain they
-            // have none.
-            Word leaving;
-            if constexpr (A == 0)
-                leaving = x + dir >= 0 && x + dir < 8 ? 0 : ~Word(0);
-            else if constexpr (A == 1)
-                leaving = dir > 0 ? kY7 : kY0;
-            else
-                leaving = dir > 0 ? kZ7 : kZ0;
-            valid[x] = n ? ~Word(0) : ~leaving;
+            valid[x] = n ? ~Word(0) : ~leaving[std::size_t(x)];
         }
     }
 
@@ -172,24 +166,6 @@ Bits readers(const Bits& bits, int reach) {
             }
         }
     });
-    return out;
-}
-
-// The voxels of a leaf within `reach` (1 or 2) steps of its face along axis A (dir = +-1).
-template <int A> Bits nearFace(int dir, int reach) {
-    using namespace leafwords;
-    Bits out{};
-    for (int x = 0; x < 8; ++x) {
-        if constexpr (A == 0) {
-            out[std::size_t(x)] = (dir > 0 ? x >= 8 - reach : x < reach) ? ~Word(0) : 0;
-        } else if constexpr (A == 1) {
-            out[std::size_t(x)] =
-                dir > 0 ? (reach > 1 ? kY7 | kY7 >> 8 : kY7) : (reach > 1 ? kY0 | kY0 << 8 : kY0);
-        } else {
-            out[std::size_t(x)] =
-                dir > 0 ? (reach > 1 ? kZ7 | kZ7 >> 1 : kZ7) : (reach > 1 ? kZ0 | kZ0 << 1 : kZ0);
-        }
-    }
     return out;
 }
 
@@ -665,10 +641,10 @@ class Renormalizer {
 
     // Solves the free voxels of leaf l (loaded in `block`) until their values hold: all of
     // them the first time the leaf is solved, later those handed in. A sweep takes the block's
-    // rows that hold voxels to solve, eight voxels at once (upwind::relaxRow), in turn forward
-    // and backward, each row reading the values of the rows before it as they now stand; the
-    // next sweep takes the voxels whose stencils read a value that moved. Returns the voxels
-    // whose values moved; `left` gets those still to solve after kMostSweeps sweeps.
+    // rows that hold voxels to solve, eight voxels at once (upwind::relaxRow), each side in the
+    // direction its distances grow, each row reading the values of the rows before it as they
+    // now stand; the next sweep takes the voxels whose stencils read a value that moved. Returns
+    // the voxels whose values moved; `left` gets those still to solve after kMostSweeps sweeps.
     Bits settle(std::size_t l, const Bits& handed, bool first, int reach, Block& block,
                 Bits& left) const {
         // Voxel sets in the block's order (readers() treats every axis alike).
@@ -686,12 +662,12 @@ class Renormalizer {
                           reach};
         Bits todo = first ? solvable : inBlockOrder(handed, axis) & solvable, changed{};
         left = Bits{};
+        // Each side in the direction its distances grow, every sweep (turning the directions
+        // in turn, as fast sweeping does, took 14% more rows on the drag).
+        const unsigned outward = unsigned(layout_[l]) >> 2;
         for (int sweep = 0; sweep < kMostSweeps; ++sweep) {
             Bits moved{};
             bool anyMoved = false;
-            // Each side in the direction its distances grow, every sweep (turning the
-            // directions in turn, as fast sweeping does, took 14% more rows on the drag).
-            const unsigned outward = unsigned(layout_[l]) >> 2;
             // The rows of each side holding voxels to solve, in its order.
             std::array<std::array<std::uint8_t, 64>, 2> list;
             std::array<int, 2> count{0, 0};
@@ -757,24 +733,25 @@ class Renormalizer {
                 const int nl = b_.neighbourLeaf(l, k);
                 if (nl < 0) continue;
                 // Only changed voxels within `reach` of the face are read across it.
-                forEachBit(changed & nearFace<decltype(a)::value>(dir, reach), [&](int off) {
-                    const bool side = isSet(neg_[l], off);
-                    const float low = std::min(block.side[side][std::size_t(block.at(off))],
-                                               dist_[(l << 9) + std::size_t(off)]);
-                    const int pos = (off >> shift) & 7;
-                    for (int step = 1; step <= reach; ++step) {
-                        const int c = pos + dir * step;
-                        const int rest = off & ~(7 << shift);
-                        if (c >= 0 && c < 8) {
-                            if (isSet(neg_[l], rest | c << shift) != side) break;
-                            continue;
+                forEachBit(
+                    changed & leafwords::nearFace<decltype(a)::value>(dir, reach), [&](int off) {
+                        const bool side = isSet(neg_[l], off);
+                        const float low = std::min(block.side[side][std::size_t(block.at(off))],
+                                                   dist_[(l << 9) + std::size_t(off)]);
+                        const int pos = (off >> shift) & 7;
+                        for (int step = 1; step <= reach; ++step) {
+                            const int c = pos + dir * step;
+                            const int rest = off & ~(7 << shift);
+                            if (c >= 0 && c < 8) {
+                                if (isSet(neg_[l], rest | c << shift) != side) break;
+                                continue;
+                            }
+                            const int n = rest | (c - 8 * dir) << shift;
+                            if (isSet(neg_[std::size_t(nl)], n) != side) break;
+                            if (dist_[(std::size_t(nl) << 9) + std::size_t(n)] > low)
+                                set(into[std::size_t(k)], n);
                         }
-                        const int n = rest | (c - 8 * dir) << shift;
-                        if (isSet(neg_[std::size_t(nl)], n) != side) break;
-                        if (dist_[(std::size_t(nl) << 9) + std::size_t(n)] > low)
-                            set(into[std::size_t(k)], n);
-                    }
-                });
+                    });
             }
         });
         for (int k = 0; k < 6; ++k) {

@@ -37,6 +37,23 @@ template <int A> Word stepped(const Word* own, int x, int dir, Word facing) {
         return x + dir >= 0 && x + dir < 8 ? own[x + dir] : facing;
 }
 
+// The voxels of a leaf within `reach` (1 or 2) steps of its face along axis A (dir = +-1):
+// those whose step of `reach` along the axis leaves the leaf.
+template <int A> Words nearFace(int dir, int reach) {
+    Words out{};
+    for (int x = 0; x < 8; ++x) {
+        if constexpr (A == 0)
+            out[std::size_t(x)] = (dir > 0 ? x >= 8 - reach : x < reach) ? ~Word(0) : 0;
+        else if constexpr (A == 1)
+            out[std::size_t(x)] =
+                dir > 0 ? (reach > 1 ? kY7 | kY7 >> 8 : kY7) : (reach > 1 ? kY0 | kY0 << 8 : kY0);
+        else
+            out[std::size_t(x)] =
+                dir > 0 ? (reach > 1 ? kZ7 | kZ7 >> 1 : kZ7) : (reach > 1 ? kZ0 | kZ0 << 1 : kZ0);
+    }
+    return out;
+}
+
 // The layer of the set `next` (the leaf one step along axis A, dir = +-1) that faces this
 // leaf, for word x, laid out as stepped<A> reads it.
 template <int A> Word facing(const Word* next, int x, int dir) {

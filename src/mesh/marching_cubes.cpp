@@ -190,79 +190,78 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) 
     thread_local LeafVertices vertices;
     vertices.clear();
     auto gradient = [&](const openvdb::Coord& c) { return centralGradient(acc, c, h); };
+    // Meshes the cube whose lowest corner is voxel `base`.
+    const auto meshCube = [&](const openvdb::Coord& base) {
+        float v[8];
+        int mask = 0;
+        for (int c = 0; c < 8; ++c) {
+            v[c] = acc.getValue(cubeCorner(base, c));
+            if (v[c] < 0.0f) mask |= 1 << c;
+        }
+        // The vertex on cube edge e, created on first use.
+        auto vertexOn = [&](int e) {
+            const mc::Edge& edge = mc::kEdges[e];
+            const openvdb::Coord c0 =
+                base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
+            int& id = vertices.onEdge(c0 - origin, edge.axis);
+            if (id < 0) {
+                id = int(chunk.positions.size());
+                // A crossing never sits on a voxel itself (a value of exactly zero there, or a
+                // division that rounds): every edge through that voxel would put its own
+                // vertex at the same point, and the triangles between them would have no
+                // area. A thousandth of a voxel along the edge keeps them apart.
+                constexpr float kOffVoxel = 1e-3f;
+                const float a = v[edge.c0], b = v[edge.c1];
+                const float t = std::clamp(a / (a - b), kOffVoxel, 1.0f - kOffVoxel);
+                openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
+                p[edge.axis] += t;
+                const openvdb::Vec3d w = place.toWorld(p);
+                chunk.positions.emplace_back(float(w.x()), float(w.y()), float(w.z()));
+                openvdb::Coord c1 = c0;
+                c1[edge.axis] += 1;
+                const Eigen::Vector3f n = (1 - t) * gradient(c0) + t * gradient(c1);
+                const float len = n.norm();
+                chunk.normals.push_back(len > 0 ? Eigen::Vector3f(n / len)
+                                                : Eigen::Vector3f(0, 0, 1));
+                chunk.edgeKeys.push_back(makeKey(c0, edge.axis));
+            }
+            return id;
+        };
+        const mc::Case& cube = mc::lookup(mask);
+        int ids[3];
+        for (const auto& tri : cube.triangles) {
+            for (int k = 0; k < 3; ++k) {
+                const int e = tri[k];
+                if (e >= mc::kCentre) {
+                    // A cycle's centre: never shared with another cube.
+                    const int cycle = e - mc::kCentre;
+                    int& id = vertices.atCentre(base - origin, cycle);
+                    if (id < 0) {
+                        Eigen::Vector3f p = Eigen::Vector3f::Zero(), nrm = Eigen::Vector3f::Zero();
+                        for (std::uint8_t ce : cube.cycles[cycle]) {
+                            const int vi = vertexOn(ce);
+                            p += chunk.positions[vi];
+                            nrm += chunk.normals[vi];
+                        }
+                        id = int(chunk.positions.size());
+                        chunk.positions.push_back(p / float(cube.cycles[cycle].size()));
+                        chunk.normals.push_back(nrm.normalized());
+                        chunk.edgeKeys.push_back(makeKey(base, 3) | (std::uint64_t(cycle) << 62));
+                    }
+                    ids[k] = id;
+                } else {
+                    ids[k] = vertexOn(e);
+                }
+            }
+            chunk.triangles.emplace_back(ids[0], ids[1], ids[2]);
+        }
+    };
     // The cubes of the leaf's active voxels that the surface crosses, in offset order.
     for (int x = 0; x < 8; ++x)
-        for (leafwords::Word w =
+        for (leafwords::Word cubes =
                  crossing[std::size_t(x)] & leaf->getValueMask().getWord<leafwords::Word>(x);
-             w; w &= w - 1) {
-            const openvdb::Coord base =
-                leaf->offsetToGlobalCoord(openvdb::Index(x * 64 + __builtin_ctzll(w)));
-            float v[8];
-            int mask = 0;
-            for (int c = 0; c < 8; ++c) {
-                v[c] = acc.getValue(cubeCorner(base, c));
-                if (v[c] < 0.0f) mask |= 1 << c;
-            }
-            // The vertex on cube edge e, created on first use.
-            auto vertexOn = [&](int e) {
-                const mc::Edge& edge = mc::kEdges[e];
-                const openvdb::Coord c0 =
-                    base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
-                int& id = vertices.onEdge(c0 - origin, edge.axis);
-                if (id < 0) {
-                    id = int(chunk.positions.size());
-                    // A crossing never sits on a voxel itself (a value of exactly zero there, or a
-                    // division that rounds): every edge through that voxel would put its own
-                    // vertex at the same point, and the triangles between them would have no
-                    // area. A thousandth of a voxel along the edge keeps them apart.
-                    constexpr float kOffVoxel = 1e-3f;
-                    const float a = v[edge.c0], b = v[edge.c1];
-                    const float t = std::clamp(a / (a - b), kOffVoxel, 1.0f - kOffVoxel);
-                    openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
-                    p[edge.axis] += t;
-                    const openvdb::Vec3d w = place.toWorld(p);
-                    chunk.positions.emplace_back(float(w.x()), float(w.y()), float(w.z()));
-                    openvdb::Coord c1 = c0;
-                    c1[edge.axis] += 1;
-                    const Eigen::Vector3f n = (1 - t) * gradient(c0) + t * gradient(c1);
-                    const float len = n.norm();
-                    chunk.normals.push_back(len > 0 ? Eigen::Vector3f(n / len)
-                                                    : Eigen::Vector3f(0, 0, 1));
-                    chunk.edgeKeys.push_back(makeKey(c0, edge.axis));
-                }
-                return id;
-            };
-            const mc::Case& cube = mc::lookup(mask);
-            int ids[3];
-            for (const auto& tri : cube.triangles) {
-                for (int k = 0; k < 3; ++k) {
-                    const int e = tri[k];
-                    if (e >= mc::kCentre) {
-                        // A cycle's centre: never shared with another cube.
-                        const int cycle = e - mc::kCentre;
-                        int& id = vertices.atCentre(base - origin, cycle);
-                        if (id < 0) {
-                            Eigen::Vector3f p = Eigen::Vector3f::Zero(),
-                                            nrm = Eigen::Vector3f::Zero();
-                            for (std::uint8_t ce : cube.cycles[cycle]) {
-                                const int vi = vertexOn(ce);
-                                p += chunk.positions[vi];
-                                nrm += chunk.normals[vi];
-                            }
-                            id = int(chunk.positions.size());
-                            chunk.positions.push_back(p / float(cube.cycles[cycle].size()));
-                            chunk.normals.push_back(nrm.normalized());
-                            chunk.edgeKeys.push_back(makeKey(base, 3) |
-                                                     (std::uint64_t(cycle) << 62));
-                        }
-                        ids[k] = id;
-                    } else {
-                        ids[k] = vertexOn(e);
-                    }
-                }
-                chunk.triangles.emplace_back(ids[0], ids[1], ids[2]);
-            }
-        }
+             cubes; cubes &= cubes - 1)
+            meshCube(leaf->offsetToGlobalCoord(openvdb::Index(x * 64 + __builtin_ctzll(cubes))));
     chunk.volume = enclosedVolume(chunk.positions, chunk.triangles);
     return true;
 }
