@@ -84,6 +84,20 @@ template <typename L>
             c[a] = one;
         }
     }
+    // A lane of +infinity stays there when every axis's m lies within 0.38 h of the
+    // background or past it: the root w below is at least h / sqrt(sum c_a) >= h / 2.6 (each
+    // term of its equation is at most c_a w^2), so m_0 + w lies past the background too. A
+    // third of the rows a drag segment's solve relaxes are such lanes only, beyond the band's
+    // edge next to voxels that moved: they return at once, unchanged.
+    const F was = load<F>(v + b);
+    {
+        const F low = m[0] < m[1] ? (m[0] < m[2] ? m[0] : m[2]) : (m[1] < m[2] ? m[1] : m[2]);
+        const I live = (low + 0.38f * block.h <= block.background) | (was < inf);
+        unsigned any = 0;
+        for (int z = 0; z < kLanes; ++z)
+            any |= unsigned(live[z] != 0) << z;
+        if (!(any & lanes)) return {was, 0u};
+    }
     // Sorted by m (a network of three compare-and-swaps; +infinity, no neighbour of the side
     // along that axis, sorts last and is never used).
     const auto order = [&](int p, int q) {
@@ -125,7 +139,6 @@ template <typename L>
     const F u = ((m[0] == inf) | (m[0] + w > block.background)) ? inf : m[0] + w;
     // Moved: by more than the tolerance, or to or from +infinity (inf - inf is NaN, which
     // compares false: no move).
-    const F was = load<F>(v + b);
     const F delta = u - was;
     I bit;
     for (int z = 0; z < kLanes; ++z)

@@ -286,3 +286,38 @@ TEST(FastMarching, RowUpdatesAreTheSameInFourLanesAndInEight) {
     }
     EXPECT_GT(moved, 1000); // the rows moved: the blocks compared were not left as they were
 }
+
+// A row returns at once when none of its lanes can come back from +infinity (their
+// neighbours lie too near the background or past it): a lane solved alone takes that way
+// where the row solved whole does not, so each lane must come out the same either way.
+TEST(FastMarching, ALaneOfARowSolvesTheSameAloneAsWithTheOthers) {
+    std::mt19937 random(12);
+    const float h = 1.0f / 128, inf = std::numeric_limits<float>::infinity();
+    // Values near the band's edge (3 h), half of them none (+infinity).
+    std::uniform_real_distribution<float> value(2.2f * h, 3.5f * h);
+    std::bernoulli_distribution none(0.5);
+    constexpr int kDim = 12; // a block: a leaf and a rim of two voxels
+    std::vector<float> whole(kDim * kDim * kDim), alone;
+    int cameBack = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        for (float& v : whole)
+            v = none(random) ? inf : value(random);
+        const std::vector<float> before = whole;
+        upwind::RowBlock block{whole.data(), kDim * kDim, kDim,         h,
+                               3.0f * h,     1e-6f * h,   1 + trial % 2};
+        const int b = (2 + trial % 8) * kDim * kDim + (2 + trial / 8 % 8) * kDim + 2;
+        const unsigned moved = upwind::relaxRow(block, b, 0xffu);
+        for (int z = 0; z < 8; ++z) {
+            alone = before;
+            upwind::RowBlock one = block;
+            one.values = alone.data();
+            ASSERT_EQ(moved & (1u << z), upwind::relaxRow(one, b, 1u << z))
+                << "trial " << trial << ", lane " << z;
+            ASSERT_EQ(whole[std::size_t(b + z)], alone[std::size_t(b + z)])
+                << "trial " << trial << ", lane " << z;
+            cameBack += before[std::size_t(b + z)] == inf && whole[std::size_t(b + z)] < inf;
+        }
+    }
+    EXPECT_GT(cameBack, 200); // lanes that were +infinity and took a value: the case tested
+}
+
