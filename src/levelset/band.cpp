@@ -41,6 +41,7 @@ using leafwords::Word;
 
 // Bit k of the word: whether v[first + k * stride] is inside, for k < count.
 Word signs(const float* v, std::size_t first, std::size_t count, std::size_t stride) {
+    if (stride == 1) return leafwords::negatives(v + first, int(count));
     Word w = 0;
     for (std::size_t k = 0; k < count; ++k)
         w |= Word(v[first + k * stride] < 0.0f) << k;

@@ -293,13 +293,8 @@ class Renormalizer {
                 dist[i] = a < bg_ ? a : kInf;
             }
             layout_[l] = layoutOf(phi);
-            Bits& neg = neg_[l];
-            for (int x = 0; x < 8; ++x) {
-                std::uint64_t word = 0;
-                for (int k = 0; k < 64; ++k)
-                    word |= std::uint64_t(negative(phi[x * 64 + k])) << k;
-                neg[std::size_t(x)] = word;
-            }
+            for (std::size_t x = 0; x < 8; ++x)
+                neg_[l][x] = leafwords::negatives(phi + 64 * x, 64);
             Bits free = leafwords::inBox(region, leaf.origin());
             if (only) {
                 const auto* mask = only->tree().probeConstLeaf(leaf.origin());

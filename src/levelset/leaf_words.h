@@ -9,12 +9,33 @@
 #include <cstdint>
 #include <type_traits>
 
+#ifdef __SSE2__
+#include <xmmintrin.h>
+#endif
+
 namespace sweepers::leafwords {
 
 using Word = std::uint64_t;
 using Words = std::array<Word, 8>;                          // a set of one leaf's voxels
 constexpr Word kZ0 = 0x0101010101010101ull, kZ7 = kZ0 << 7; // the voxels at z = 0, z = 7
 constexpr Word kY0 = 0xffull, kY7 = kY0 << 56;              // the voxels at y = 0, y = 7
+
+// Bit k: whether v[k] < 0, for k < n (n <= 64): the signs of a row or a word of a leaf's
+// values, four compares at once where the CPU has SSE (a compare, a shift and an or per
+// value made the scans for the surface 5% of a drag segment at 1/256). The same answer as
+// `v[k] < 0.0f` for every value, -0 and NaN included.
+inline Word negatives(const float* v, int n) {
+    Word w = 0;
+    int k = 0;
+#ifdef __SSE2__
+    const __m128 zero = _mm_setzero_ps();
+    for (; k + 4 <= n; k += 4)
+        w |= Word(unsigned(_mm_movemask_ps(_mm_cmplt_ps(_mm_loadu_ps(v + k), zero)))) << k;
+#endif
+    for (; k < n; ++k)
+        w |= Word(v[k] < 0.0f) << k;
+    return w;
+}
 
 // Whether the set holds any voxel.
 inline bool any(const Words& set) {

@@ -67,10 +67,7 @@ class LeafBlock {
         for (std::size_t x = 0; x < kRows; ++x)
             for (std::size_t y = 0; y < kRows; ++y) {
                 const float* row = &values_[((x + 1) * kSpan + (y + 1)) * kSpan + 1];
-                unsigned bits = 0;
-                for (int z = 0; z <= kDim; ++z)
-                    bits |= unsigned(row[z] < 0.0f) << z;
-                negative[x * kRows + y] = bits;
+                negative[x * kRows + y] = unsigned(leafwords::negatives(row, kDim + 1));
             }
         leafwords::Words out{};
         for (std::size_t x = 0; x < kDim; ++x)

@@ -14,6 +14,7 @@
 #include "grids.h"
 #include "levelset/band.h"
 #include "levelset/fast_marching.h"
+#include "levelset/leaf_words.h"
 #include "levelset/upwind_row.h"
 
 using namespace sweepers;
@@ -321,3 +322,30 @@ TEST(FastMarching, ALaneOfARowSolvesTheSameAloneAsWithTheOthers) {
     EXPECT_GT(cameBack, 200); // lanes that were +infinity and took a value: the case tested
 }
 
+// The signs of a leaf's values, four at a time where the CPU can: bit k is `v[k] < 0` for any
+// count and any alignment, with zeros of either sign, infinities and NaN among the values.
+TEST(LeafWords, NegativesAreTheSignsOfTheValues) {
+    std::mt19937 random(13);
+    const float specials[] = {0.0f,
+                              -0.0f,
+                              std::numeric_limits<float>::infinity(),
+                              -std::numeric_limits<float>::infinity(),
+                              std::numeric_limits<float>::quiet_NaN(),
+                              -std::numeric_limits<float>::quiet_NaN(),
+                              std::numeric_limits<float>::denorm_min(),
+                              -std::numeric_limits<float>::denorm_min()};
+    std::uniform_real_distribution<float> value(-1.0f, 1.0f);
+    std::uniform_int_distribution<int> kind(0, 15);
+    std::vector<float> v(80);
+    for (int trial = 0; trial < 500; ++trial) {
+        for (float& x : v) {
+            const int k = kind(random);
+            x = k < 8 ? specials[k] : value(random);
+        }
+        const int first = trial % 8, n = 1 + trial % 64;
+        leafwords::Word expected = 0;
+        for (int k = 0; k < n; ++k)
+            expected |= leafwords::Word(v[std::size_t(first + k)] < 0.0f) << k;
+        ASSERT_EQ(expected, leafwords::negatives(v.data() + first, n)) << "trial " << trial;
+    }
+}
