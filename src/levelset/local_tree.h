@@ -62,35 +62,44 @@ void copyBox(const openvdb::CoordBBox& box, float* out, const LeafAt& leafAt,
                 openvdb::CoordBBox part(o, o.offsetBy(kDim - 1));
                 part.intersect(box);
                 const LeafNode* leaf = leafAt(o);
-                const float tile = leaf ? 0.0f : float(valueAt(o));
-                const float* values = leaf ? leaf->buffer().data() : nullptr;
-                const int z0 = part.min().z(), n = part.max().z() - z0 + 1;
-                for (int x = part.min().x(); x <= part.max().x(); ++x)
-                    for (int y = part.min().y(); y <= part.max().y(); ++y) {
-                        float* row = out + at(x, y, z0);
-                        if (!leaf) {
-                            std::fill(row, row + n, tile);
-                            continue;
+                const openvdb::Coord lo = part.min(), n = part.dim();
+                // The part's rows, stepped through by strides (an index computed per row was
+                // most of a block's cost).
+                float* const to = out + at(lo.x(), lo.y(), lo.z());
+                const std::size_t toY = std::size_t(size.z()), toX = std::size_t(size.y()) * toY;
+                if (!leaf) {
+                    const float tile = float(valueAt(o));
+                    for (int x = 0; x < n.x(); ++x)
+                        for (int y = 0; y < n.y(); ++y) {
+                            float* row = to + std::size_t(x) * toX + std::size_t(y) * toY;
+                            std::fill(row, row + n.z(), tile);
                         }
-                        const float* from = values + LeafNode::coordToOffset({x, y, z0});
-                        // The rows a block around a leaf reads are a whole leaf row or one or
-                        // two voxels of its neighbours': copied by fixed sizes, where a copy
-                        // of any length was a library call per row (the blocks of meshing and
-                        // sampling took 6.6% of a drag's samples at 1/128 that way, 4.8% now).
-                        switch (n) {
-                        case kDim:
-                            std::memcpy(row, from, sizeof(float) * kDim);
-                            break;
-                        case 2:
-                            std::memcpy(row, from, sizeof(float) * 2);
-                            break;
-                        case 1:
-                            row[0] = from[0];
-                            break;
-                        default:
-                            std::copy(from, from + n, row);
-                        }
-                    }
+                    continue;
+                }
+                const float* const from = leaf->buffer().data() + LeafNode::coordToOffset(lo);
+                const auto rows = [&](auto length) {
+                    for (int x = 0; x < n.x(); ++x)
+                        for (int y = 0; y < n.y(); ++y)
+                            std::memcpy(to + std::size_t(x) * toX + std::size_t(y) * toY,
+                                        from + std::size_t(x * kDim * kDim + y * kDim),
+                                        sizeof(float) * std::size_t(int(length)));
+                };
+                // The rows a block around a leaf reads are a whole leaf row or one or two
+                // voxels of its neighbours': copied by fixed sizes, where a copy of any length
+                // is a library call per row.
+                switch (n.z()) {
+                case kDim:
+                    rows(std::integral_constant<int, kDim>{});
+                    break;
+                case 2:
+                    rows(std::integral_constant<int, 2>{});
+                    break;
+                case 1:
+                    rows(std::integral_constant<int, 1>{});
+                    break;
+                default:
+                    rows(n.z());
+                }
             }
 }
 
