@@ -67,22 +67,22 @@ void copyBox(const openvdb::CoordBBox& box, float* out, const LeafAt& leafAt,
                 // most of a block's cost).
                 float* const to = out + at(lo.x(), lo.y(), lo.z());
                 const std::size_t toY = std::size_t(size.z()), toX = std::size_t(size.y()) * toY;
+                const auto forEachRow = [&](const auto& body) {
+                    for (int x = 0; x < n.x(); ++x)
+                        for (int y = 0; y < n.y(); ++y)
+                            body(to + std::size_t(x) * toX + std::size_t(y) * toY,
+                                 (std::size_t(x) * kDim + std::size_t(y)) * kDim);
+                };
                 if (!leaf) {
                     const float tile = float(valueAt(o));
-                    for (int x = 0; x < n.x(); ++x)
-                        for (int y = 0; y < n.y(); ++y) {
-                            float* row = to + std::size_t(x) * toX + std::size_t(y) * toY;
-                            std::fill(row, row + n.z(), tile);
-                        }
+                    forEachRow([&](float* row, std::size_t) { std::fill(row, row + n.z(), tile); });
                     continue;
                 }
                 const float* const from = leaf->buffer().data() + LeafNode::coordToOffset(lo);
                 const auto rows = [&](auto length) {
-                    for (int x = 0; x < n.x(); ++x)
-                        for (int y = 0; y < n.y(); ++y)
-                            std::memcpy(to + std::size_t(x) * toX + std::size_t(y) * toY,
-                                        from + std::size_t(x * kDim * kDim + y * kDim),
-                                        sizeof(float) * std::size_t(int(length)));
+                    forEachRow([&](float* row, std::size_t offset) {
+                        std::memcpy(row, from + offset, sizeof(float) * std::size_t(int(length)));
+                    });
                 };
                 // The rows a block around a leaf reads are a whole leaf row or one or two
                 // voxels of its neighbours': copied by fixed sizes, where a copy of any length

@@ -46,6 +46,14 @@ template <typename F> [[gnu::always_inline]] inline F sqrtOf(F x) {
     return x;
 }
 
+// Bit z: whether lane z of the mask is set.
+template <typename I> [[gnu::always_inline]] inline unsigned lanesOf(I mask) {
+    unsigned out = 0;
+    for (std::size_t z = 0; z < sizeof(I) / sizeof(int); ++z)
+        out |= unsigned(mask[z] != 0) << z;
+    return out;
+}
+
 // The new values of the lanes of the row from block index b (kept where they did not move,
 // or are not in `lanes`), and the lanes that moved.
 template <typename L> struct Solved {
@@ -93,10 +101,7 @@ template <typename L>
     {
         const F low = m[0] < m[1] ? (m[0] < m[2] ? m[0] : m[2]) : (m[1] < m[2] ? m[1] : m[2]);
         const I live = (low + 0.38f * block.h <= block.background) | (was < inf);
-        unsigned any = 0;
-        for (int z = 0; z < kLanes; ++z)
-            any |= unsigned(live[z] != 0) << z;
-        if (!(any & lanes)) return {was, 0u};
+        if (!(lanesOf(live) & lanes)) return {was, 0u};
     }
     // Sorted by m (a network of three compare-and-swaps; +infinity, no neighbour of the side
     // along that axis, sorts last and is never used).
@@ -145,10 +150,7 @@ template <typename L>
         bit[z] = 1 << z;
     const I take =
         ((delta > block.tolerance) | (delta < -block.tolerance)) & ((bit & int(lanes)) != 0);
-    Solved<L> out{take ? u : was, 0u};
-    for (int z = 0; z < kLanes; ++z)
-        out.moved |= unsigned(take[z] & bit[z]);
-    return out;
+    return {take ? u : was, lanesOf(take)};
 }
 
 } // namespace
