@@ -476,13 +476,15 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         }
     }
     stats.interfaceVoxels = interface.size();
-    // Each thread marks the images in a mask of its own; the masks are merged after.
-    tbb::enumerable_thread_specific<openvdb::MaskTree> marks;
+    // Each thread marks the images in a mask of its own; the masks are merged after, into the
+    // first of them (copying it into an empty tree made every leaf and node again).
+    tbb::enumerable_thread_specific<openvdb::MaskTree::Ptr> marks(
+        [] { return std::make_shared<openvdb::MaskTree>(); });
     const VoxelPlacement place(grid.transform());
     tbb::enumerable_thread_specific<double> stretch(1.0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
         pollInterrupt(options.interrupter);
-        openvdb::tree::ValueAccessor<openvdb::MaskTree, false> m(marks.local());
+        openvdb::tree::ValueAccessor<openvdb::MaskTree, false> m(*marks.local());
         double& worst = stretch.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             Eigen::Vector3d p = toEigen(place.toWorld(interface[i].asVec3d()));
@@ -510,8 +512,14 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     });
     openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create();
     mask->setTransform(grid.transform().copy());
-    for (const openvdb::MaskTree& m : marks)
-        mask->tree().topologyUnion(m);
+    bool first = true;
+    for (const openvdb::MaskTree::Ptr& m : marks) {
+        if (first)
+            mask->setTree(m);
+        else
+            uniteMasks(mask->tree(), *m);
+        first = false;
+    }
     // The band the images are dilated into, sampled: what renormalization's seeds read (the
     // voxels next to the new crossing and their face neighbours) lies within kSeedReach of
     // them, and sampling is checked to have reached it all (else the images are dilated as
@@ -638,7 +646,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             stats.sampledReach = bandReach;
             openvdb::MaskTree added;
             switchOn(mask->tree(), added);
-            fresh->tree().topologyUnion(added);
+            uniteMasks(fresh->tree(), added);
             std::vector<LeafNode*> all = leavesIn(grid.tree(), region), grown;
             // `sampled` is in the tree's order, and the tree only gained leaves.
             for (std::size_t i = 0, j = 0; i < all.size(); ++i) {
@@ -689,7 +697,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         // surface of a voxel nearby may have moved): where the deformation is the identity
         // (outside the tools' coatings, which fill only part of the box) the distances hold.
         dilateByCube(changed->tree(), int(std::ceil(halfWidth)) + 1);
-        changed->tree().topologyUnion(fresh->tree());
+        uniteMasks(changed->tree(), fresh->tree());
         const FmmStats fmm =
             renormalize(grid, touched, *changed, options.renormalization, options.interrupter);
         stats.leavesVisited += fmm.leaves;

@@ -217,4 +217,20 @@ void dilateByCube(openvdb::MaskTree& tree, int radius) {
     if (!leaves.empty()) dilateInto(leaves.begin(), leaves.end(), radius, tree);
 }
 
+void uniteMasks(openvdb::MaskTree& into, const openvdb::MaskTree& from) {
+    if (from.hasActiveTiles()) {
+        into.topologyUnion(from);
+        return;
+    }
+    // Through an accessor: the leaves come in the tree's order, so most lie in the internal
+    // node of the one before.
+    openvdb::tree::ValueAccessor<openvdb::MaskTree, false> acc(into);
+    for (auto it = from.cbeginLeaf(); it; ++it) {
+        if (it->isEmpty()) continue;
+        auto& words = acc.touchLeaf(it->origin())->getValueMask();
+        for (int x = 0; x < kDim; ++x)
+            words.getWord<Word>(x) |= it->getValueMask().getWord<Word>(x);
+    }
+}
+
 } // namespace sweepers

@@ -1,5 +1,8 @@
-// Dilation of a voxel mask by a cube: every voxel within `radius` steps along each axis of
-// an active one becomes active (what `radius` rounds of 26-neighbour dilation give).
+// The voxel masks of a segment's work, a leaf's words at a time: dilation by a cube, and
+// union.
+//
+// Dilation by a cube: every voxel within `radius` steps along each axis of an active one
+// becomes active (what `radius` rounds of 26-neighbour dilation give).
 //
 // A sculpting segment dilates two brush-sized masks by the band's half-width. The cube is
 // separable, so it is done as three one-dimensional dilations on the 64-bit words of the
@@ -15,5 +18,12 @@ namespace sweepers {
 // Dilates the active voxels of the leaves of `tree` by the cube of half-side `radius`
 // (radius >= 0). Active tiles are left as they are.
 void dilateByCube(openvdb::MaskTree& tree, int radius);
+
+// Adds the active voxels of `from` to `into`: the active voxels of into.topologyUnion(from),
+// a leaf of `from` at a time. OpenVDB's union works through the internal nodes' tables:
+// adding a segment's new band to its changed voxels (the drag at 1/128) took 2.75M
+// instructions that way and takes 0.14M this way. A mask with active tiles takes
+// OpenVDB's union.
+void uniteMasks(openvdb::MaskTree& into, const openvdb::MaskTree& from);
 
 } // namespace sweepers

@@ -73,3 +73,26 @@ TEST(DilateByCube, RefusesANegativeRadius) {
     tree.setValueOn(openvdb::Coord(0));
     EXPECT_THROW(dilateByCube(tree, -1), std::invalid_argument);
 }
+
+// The union a leaf at a time gives OpenVDB's union: masks overlapping in some leaves and not
+// in others, an empty leaf in the added mask (which adds no voxel), and a mask holding an
+// active tile (which takes OpenVDB's union).
+TEST(UniteMasks, EqualsOpenVdbTopologyUnion) {
+    for (unsigned seed = 1; seed <= 3; ++seed) {
+        const auto into = randomMask(seed), from = randomMask(seed + 10);
+        from->touchLeaf(openvdb::Coord(200, 200, 200)); // a leaf with no voxel on
+        auto expected = std::make_shared<openvdb::MaskTree>(*into);
+        expected->topologyUnion(*from);
+        uniteMasks(*into, *from);
+        EXPECT_EQ(into->activeVoxelCount(), expected->activeVoxelCount()) << seed;
+        for (auto it = expected->cbeginValueOn(); it; ++it)
+            ASSERT_TRUE(into->isValueOn(it.getCoord())) << seed << " " << it.getCoord();
+    }
+    const auto into = randomMask(7);
+    openvdb::MaskTree tiled;
+    tiled.addTile(1, openvdb::Coord(-64, 0, 0), true, true); // a tile of 8^3 voxels
+    const openvdb::Index64 before = into->activeVoxelCount();
+    uniteMasks(*into, tiled);
+    EXPECT_TRUE(into->isValueOn(openvdb::Coord(-60, 3, 5)));
+    EXPECT_GE(into->activeVoxelCount(), before);
+}
