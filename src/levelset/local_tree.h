@@ -108,8 +108,9 @@ void copyBox(const openvdb::CoordBBox& box, float* out, const LeafAt& leafAt,
 
 // Re-derives the signs of a leaf's inactive values from its active ones, to the bit as
 // tools::SignedFloodFillOp does: each inactive voxel takes the side of the active voxel
-// before it along its row (z), a row without one the side of the last active first voxel
-// of the rows before it (y), and a slab the same along x. OpenVDB's takes a branch on every
+// before it along its row (z); a row starts from the side of the last active voxel that
+// began a row before it in its slab (y), and a slab from the last active voxel that began a
+// slab before it (x), the leaf from its first active voxel. OpenVDB's takes a branch on every
 // voxel's state; here the rows' states and signs are bytes of the masks' words, and a row's
 // values are chosen without branches (a drag segment at 1/128 floods about 560 leaves).
 inline void floodLeafSigns(LeafNode& leaf, float inside, float outside) {
