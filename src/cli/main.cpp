@@ -267,7 +267,7 @@ int runApply(const ApplyArgs& a) {
     Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop, a.force),
                       options);
     const Grid& grid = sculptor.grid();
-    const double before = measureLevelSet(grid).volume;
+    const double before = levelSetVolume(grid);
     if (a.stats) sculptor.startMeshing();
     const double meshBefore = a.stats ? sculptor.mesher().enclosedVolume() : 0.0;
     const auto reports =
@@ -310,7 +310,7 @@ int runApply(const ApplyArgs& a) {
     }
     vdb.commit();
     if (meshFile) meshFile->commit();
-    const double after = measureLevelSet(grid).volume;
+    const double after = levelSetVolume(grid);
     if (!a.quiet)
         std::fprintf(stderr,
                      "wrote %s: %zu segments (band growth %.3f s, sampling %.3f s, "

@@ -20,7 +20,7 @@ LevelSetMeasures measureLevelSet(const Grid& grid) {
     m.bounds = activeWorldBox(grid);
     if (m.activeVoxels == 0) return m;
     openvdb::tools::LevelSetMeasure<Grid> measure(grid);
-    m.volume = measure.volume(true);
+    m.volume = measure.volume(true); // as levelSetVolume
     m.area = measure.area(true);
     m.curvatureEuler = measure.eulerCharacteristic();
     m.eulerCharacteristic = topologicalEulerCharacteristic(grid);
@@ -29,6 +29,12 @@ LevelSetMeasures measureLevelSet(const Grid& grid) {
     m.components = parts.size();
     m.genus = int(m.components) - m.eulerCharacteristic / 2;
     return m;
+}
+
+double levelSetVolume(const Grid& grid) {
+    if (grid.activeVoxelCount() == 0) return 0.0;
+    openvdb::tools::LevelSetMeasure<Grid> measure(grid);
+    return measure.volume(true);
 }
 
 int topologicalEulerCharacteristic(const Grid& grid) {

@@ -105,12 +105,13 @@ TEST(MarchingCubes, SphereAndTorusMeshes) {
     struct Shape {
         GridPtr grid;
         long chi;
+        double volume;
     };
     const std::vector<Shape> shapes{
-        {makeSphere({0.1, 0, 0}, 0.7, h, 3), 2},
+        {makeSphere({0.1, 0, 0}, 0.7, h, 3), 2, 4.0 / 3.0 * M_PI * std::pow(0.7, 3)},
         {test::gridFromSdf([](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); }, h,
                            3, openvdb::CoordBBox::createCube({-40, -40, -15}, 80)),
-         0}};
+         0, 2.0 * M_PI * M_PI * 0.6 * 0.25 * 0.25}};
     for (const Shape& s : shapes) {
         const TriangleMesh m = meshLevelSet(*s.grid);
         const MeshTopology t = meshTopology(m);
@@ -119,6 +120,9 @@ TEST(MarchingCubes, SphereAndTorusMeshes) {
         EXPECT_EQ(t.eulerCharacteristic(), s.chi);
         EXPECT_EQ(topologicalEulerCharacteristic(*s.grid), s.chi);
         const double grid = openvdb::tools::levelSetVolume(*s.grid);
+        // The volume alone (what `apply` reports) is the full measure's, and the shape's.
+        EXPECT_EQ(levelSetVolume(*s.grid), measureLevelSet(*s.grid).volume);
+        EXPECT_NEAR(levelSetVolume(*s.grid), s.volume, 0.005 * s.volume);
         EXPECT_NEAR(enclosedVolume(m), grid, 0.01 * grid); // positive: normals face out
         // Vertex normals (SDF gradient) agree with the triangles' orientation.
         std::size_t agree = 0;
