@@ -129,12 +129,15 @@ class FileWriter : public openvdb::io::Archive {
 AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path, const openvdb::MetaMap& meta,
                             const openvdb::GridCPtrVec& beside) {
     initVdb();
-    GridPtr copy = grid.deepCopy();
-    markAsDocument(*copy);
-    copy->insertMeta("voxel_size", openvdb::FloatMetadata(float(grid.voxelSize()[0])));
+    // The file's metadata is put together on a grid without voxels and written with the
+    // grid's own tree (shared, only read): a deep copy of the voxels, to add a few names,
+    // held the grid's memory twice while the file was written.
+    GridPtr named = grid.copyWithNewTree();
+    markAsDocument(*named);
+    named->insertMeta("voxel_size", openvdb::FloatMetadata(float(grid.voxelSize()[0])));
     for (auto it = meta.beginMeta(); it != meta.endMeta(); ++it)
-        copy->insertMeta(it->first, *it->second);
-    openvdb::GridCPtrVec grids{copy};
+        named->insertMeta(it->first, *it->second);
+    openvdb::GridCPtrVec grids{grid.copyReplacingMetadata(*named)};
     grids.insert(grids.end(), beside.begin(), beside.end());
     return prepareGrids(grids, path);
 }
