@@ -32,9 +32,8 @@ LevelSetMeasures measureLevelSet(const Grid& grid) {
 }
 
 double levelSetVolume(const Grid& grid) {
-    if (grid.activeVoxelCount() == 0) return 0.0;
-    openvdb::tools::LevelSetMeasure<Grid> measure(grid);
-    return measure.volume(true);
+    // OpenVDB's, which throws on a grid without voxels where the full measure says 0.
+    return grid.activeVoxelCount() == 0 ? 0.0 : openvdb::tools::levelSetVolume(grid);
 }
 
 int topologicalEulerCharacteristic(const Grid& grid) {

@@ -89,7 +89,7 @@ TEST(Advect, EnclosedSphereTranslatesExactly) {
     const Grid& g = *t.grid;
     const TriangleMesh mesh = meshLevelSet(g);
     const Eigen::Vector3d c = centroid(mesh);
-    const double volume = measureLevelSet(g).volume, exactVolume = 4.0 / 3.0 * M_PI;
+    const double volume = levelSetVolume(g), exactVolume = 4.0 / 3.0 * M_PI;
     const double rms =
         interfaceRms(g, [&](const Eigen::Vector3d& p) { return (p - t.d).norm() - 1.0; });
     std::printf("[ advect ] centre off by %.4f voxels, volume %+.3f%%, interface RMS %.4f voxels\n",
@@ -177,7 +177,7 @@ TEST(Advect, SamplingReachesEverySeedOfRenormalization) {
                 f, stats.sampledReach, largest);
     EXPECT_LT(largest, 0.2);
     const double exact = 4.0 / 3.0 * M_PI * std::pow(f * r, 3);
-    EXPECT_NEAR(measureLevelSet(*g).volume, exact, 0.01 * exact);
+    EXPECT_NEAR(levelSetVolume(*g), exact, 0.01 * exact);
 }
 
 TEST(Advect, MonotoneCubicNeverOvershoots) {

@@ -89,7 +89,7 @@ TEST(Film, RunsFromTheStartToWhatApplyGives) {
     // including the frames inside a segment (2, 3 and 5, 6: the ball part of the way).
     double before = 0.0;
     for (std::size_t n = 1; n <= 7; ++n) {
-        const double volume = measureLevelSet(*frames.at(n)).volume;
+        const double volume = levelSetVolume(*frames.at(n));
         EXPECT_GT(volume, before + 1e-4) << "frame " << n;
         before = volume;
     }
@@ -284,9 +284,9 @@ TEST(Film, AKeyframedGrabThatComesBackGivesBackTheStart) {
     const auto frames = play(s, timing);
     ASSERT_EQ(frames.size(), 11u);
     Sculptor start = startOf(s);
-    const double rest = measureLevelSet(start.grid()).volume;
+    const double rest = levelSetVolume(start.grid());
     // Out along the curve, and back: the middle frames are pulled, the last is the start.
-    EXPECT_GT(measureLevelSet(*frames.at(5)).volume, rest + 1e-3);
+    EXPECT_GT(levelSetVolume(*frames.at(5)), rest + 1e-3);
     // At 0.4 s the ball is up at (0.65, 0.1): the grabbed clay reaches x = 0.6 above the
     // equator, which the sphere (radius 0.5) does not.
     EXPECT_EQ(heightAt(start.grid(), 0.6), 0.0);

@@ -158,11 +158,11 @@ TEST(Advect, SwirlsKeepVolumeWhereSweepsDoNot) {
     // A unit sphere 256 voxels across (64 in the coarse variant).
     const double h = coarse() ? 1.0 / 32 : 1.0 / 128;
     Sculptor a(makeStartGrid(swirls, SWEEPERS_DATA_DIR, h)), b(a.grid().deepCopy());
-    const double v0 = measureLevelSet(a.grid()).volume;
+    const double v0 = levelSetVolume(a.grid());
     applyStrokes(a, swirls.strokes);
     applyStrokes(b, sweeps.strokes);
-    const double swirlDrift = (measureLevelSet(a.grid()).volume - v0) / v0;
-    const double sweepDrift = (measureLevelSet(b.grid()).volume - v0) / v0;
+    const double swirlDrift = (levelSetVolume(a.grid()) - v0) / v0;
+    const double sweepDrift = (levelSetVolume(b.grid()) - v0) / v0;
     std::printf("[ volume ] 50 strokes at voxel size %g: swirls %+.3f%%, sweeps %+.3f%%\n", h,
                 100 * swirlDrift, 100 * sweepDrift);
     EXPECT_LT(std::abs(swirlDrift), 0.01);
