@@ -155,6 +155,38 @@ class LeafVertices {
     std::uint32_t generation_ = 0;
 };
 
+// The central-difference gradients at a leaf's cube corners (leaf-local, 0 to 8 along each
+// axis), each computed once per leaf: a corner ends up to six crossing edges, and every
+// vertex on an edge blends the gradients at both its ends. One table per thread, emptied
+// for each leaf by a new generation number, as LeafVertices is.
+class CornerGradients {
+  public:
+    static constexpr int kCorners = int(LeafNode::DIM) + 1;
+    void clear() {
+        if (++generation_ == 0) {
+            stamps_.fill(0);
+            generation_ = 1;
+        }
+    }
+    template <typename Compute>
+    const Eigen::Vector3f& at(const openvdb::Coord& local, const Compute& compute) {
+        const std::size_t k =
+            (std::size_t(local.x()) * kCorners + std::size_t(local.y())) * kCorners +
+            std::size_t(local.z());
+        if (stamps_[k] != generation_) {
+            stamps_[k] = generation_;
+            gradients_[k] = compute();
+        }
+        return gradients_[k];
+    }
+
+  private:
+    static constexpr std::size_t kSlots = std::size_t(kCorners) * kCorners * kCorners;
+    std::array<std::uint32_t, kSlots> stamps_{};
+    std::array<Eigen::Vector3f, kSlots> gradients_;
+    std::uint32_t generation_ = 0;
+};
+
 // Meshes the leaf at `origin` into `chunk`, whose vectors keep their storage: re-meshing a
 // segment's leaves allocates nothing once their chunks have grown.
 // Returns whether the chunk changed: made again, or emptied (a chunk made from the same
@@ -186,7 +218,11 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& chunk) 
     const double h = grid.voxelSize()[0];
     thread_local LeafVertices vertices;
     vertices.clear();
-    auto gradient = [&](const openvdb::Coord& c) { return centralGradient(acc, c, h); };
+    thread_local CornerGradients gradients;
+    gradients.clear();
+    auto gradient = [&](const openvdb::Coord& c) -> const Eigen::Vector3f& {
+        return gradients.at(c - origin, [&] { return centralGradient(acc, c, h); });
+    };
     // Meshes the cube whose lowest corner is voxel `base`.
     const auto meshCube = [&](const openvdb::Coord& base) {
         float v[8];

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <set>
 
@@ -133,6 +135,20 @@ TEST(MarchingCubes, SphereAndTorusMeshes) {
         }
         EXPECT_GT(double(agree) / m.triangles.size(), 0.999);
     }
+}
+
+// Each vertex normal (the gradients at its edge's two corners, blended) is the sphere's own
+// normal there, to within the grid's central differences.
+TEST(MarchingCubes, VertexNormalsAreTheSurfaceNormals) {
+    const Eigen::Vector3f centre(0.1f, 0.0f, 0.0f);
+    const TriangleMesh m = meshLevelSet(*makeSphere(centre.cast<double>(), 0.7, 1.0 / 40, 3));
+    ASSERT_FALSE(m.normals.empty());
+    float worst = 1.0f;
+    for (std::size_t i = 0; i < m.positions.size(); ++i)
+        worst = std::min(worst, m.normals[i].dot((m.positions[i] - centre).normalized()));
+    std::printf("[ normals ] %zu vertices, least cosine to the sphere's normal %.6f\n",
+                m.positions.size(), double(worst));
+    EXPECT_GT(worst, 0.9995f);
 }
 
 // A pull and the push back, each re-meshed incrementally (into the chunks' kept storage):
