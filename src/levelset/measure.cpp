@@ -20,7 +20,7 @@ LevelSetMeasures measureLevelSet(const Grid& grid) {
     m.bounds = activeWorldBox(grid);
     if (m.activeVoxels == 0) return m;
     openvdb::tools::LevelSetMeasure<Grid> measure(grid);
-    m.volume = measure.volume(true); // as levelSetVolume
+    m.volume = measure.volume(true);
     m.area = measure.area(true);
     m.curvatureEuler = measure.eulerCharacteristic();
     m.eulerCharacteristic = topologicalEulerCharacteristic(grid);

@@ -112,29 +112,49 @@ bool sharedAcrossLeaves(std::uint64_t key, const openvdb::Coord& origin) {
     return false;
 }
 
-// The vertices a leaf's cubes have made so far, by where they lie: a crossing on the edge
-// from a cube corner (leaf-local, 0 to 8 along each axis) along an axis, or the centre of
-// one of a cube's cycles (a cube has at most four: that many corners of a cube can be
-// pairwise non-adjacent). Array lookups instead of a hash map (meshing is a sixth of a
-// stroke segment); one table per thread, emptied for each leaf by a new generation number
-// instead of being refilled.
-class LeafVertices {
+// A table of N entries emptied for each leaf by a new generation number instead of being
+// refilled (one per thread): an entry is claimed the first time it is asked for in a
+// generation, and holds what it was given since.
+template <typename T, std::size_t N> class LeafTable {
   public:
-    static constexpr int kCorners = int(LeafNode::DIM) + 1, kMaxCycles = 4;
-    static constexpr std::size_t kEdges = std::size_t(kCorners) * kCorners * kCorners * 3;
     void clear() {
         if (++generation_ == 0) { // after 2^32 leaves: stamps could repeat
             stamps_.fill(0);
             generation_ = 1;
         }
     }
+    // Whether entry k is new in this generation (it is claimed, its value left to set).
+    bool claim(std::size_t k) {
+        if (stamps_[k] == generation_) return false;
+        stamps_[k] = generation_;
+        return true;
+    }
+    T& operator[](std::size_t k) { return values_[k]; }
+
+  private:
+    std::array<std::uint32_t, N> stamps_{};
+    std::array<T, N> values_;
+    std::uint32_t generation_ = 0;
+};
+
+// Cube corners of a leaf, leaf-local (0 to 8 along each axis).
+constexpr int kCorners = int(LeafNode::DIM) + 1;
+std::size_t cornerIndex(const openvdb::Coord& local) {
+    return (std::size_t(local.x()) * kCorners + std::size_t(local.y())) * kCorners +
+           std::size_t(local.z());
+}
+
+// The vertices a leaf's cubes have made so far, by where they lie: a crossing on the edge
+// from a cube corner along an axis, or the centre of one of a cube's cycles (a cube has at
+// most four: that many corners of a cube can be pairwise non-adjacent). Array lookups
+// instead of a hash map (meshing is a sixth of a stroke segment).
+class LeafVertices {
+  public:
+    static constexpr int kMaxCycles = 4;
+    static constexpr std::size_t kEdges = std::size_t(kCorners) * kCorners * kCorners * 3;
+    void clear() { ids_.clear(); }
     int& onEdge(const openvdb::Coord& local, int axis) {
-        const std::size_t k =
-            ((std::size_t(local.x()) * kCorners + std::size_t(local.y())) * kCorners +
-             std::size_t(local.z())) *
-                3 +
-            std::size_t(axis);
-        return slot(k);
+        return slot(cornerIndex(local) * 3 + std::size_t(axis));
     }
     int& atCentre(const openvdb::Coord& local, int cycle) {
         return slot(kEdges + std::size_t(LeafNode::coordToOffset(local)) * kMaxCycles +
@@ -143,48 +163,27 @@ class LeafVertices {
 
   private:
     int& slot(std::size_t k) { // -1 until set in this generation
-        if (stamps_[k] != generation_) {
-            stamps_[k] = generation_;
-            ids_[k] = -1;
-        }
+        if (ids_.claim(k)) ids_[k] = -1;
         return ids_[k];
     }
-    static constexpr std::size_t kSlots = kEdges + std::size_t(LeafNode::SIZE) * kMaxCycles;
-    std::array<std::uint32_t, kSlots> stamps_{};
-    std::array<int, kSlots> ids_;
-    std::uint32_t generation_ = 0;
+    LeafTable<int, kEdges + std::size_t(LeafNode::SIZE) * kMaxCycles> ids_;
 };
 
-// The central-difference gradients at a leaf's cube corners (leaf-local, 0 to 8 along each
-// axis), each computed once per leaf: a corner ends up to six crossing edges, and every
-// vertex on an edge blends the gradients at both its ends. One table per thread, emptied
-// for each leaf by a new generation number, as LeafVertices is.
+// The central-difference gradients at a leaf's cube corners, each computed once per leaf: a
+// corner ends up to six crossing edges, and every vertex on an edge blends the gradients at
+// both its ends.
 class CornerGradients {
   public:
-    static constexpr int kCorners = int(LeafNode::DIM) + 1;
-    void clear() {
-        if (++generation_ == 0) {
-            stamps_.fill(0);
-            generation_ = 1;
-        }
-    }
+    void clear() { gradients_.clear(); }
     template <typename Compute>
     const Eigen::Vector3f& at(const openvdb::Coord& local, const Compute& compute) {
-        const std::size_t k =
-            (std::size_t(local.x()) * kCorners + std::size_t(local.y())) * kCorners +
-            std::size_t(local.z());
-        if (stamps_[k] != generation_) {
-            stamps_[k] = generation_;
-            gradients_[k] = compute();
-        }
+        const std::size_t k = cornerIndex(local);
+        if (gradients_.claim(k)) gradients_[k] = compute();
         return gradients_[k];
     }
 
   private:
-    static constexpr std::size_t kSlots = std::size_t(kCorners) * kCorners * kCorners;
-    std::array<std::uint32_t, kSlots> stamps_{};
-    std::array<Eigen::Vector3f, kSlots> gradients_;
-    std::uint32_t generation_ = 0;
+    LeafTable<Eigen::Vector3f, std::size_t(kCorners) * kCorners * kCorners> gradients_;
 };
 
 // Meshes the leaf at `origin` into `chunk`, whose vectors keep their storage: re-meshing a
