@@ -5,10 +5,9 @@
 #include <stdexcept>
 
 #include <Eigen/Geometry>
-#include <Eigen/IterativeLinearSolvers>
-#include <Eigen/Sparse>
 
 #include "core/monotone_cubic.h"
+#include "deform/box_solve.h"
 #include "deform/flow.h"
 #include "deform/step_chain.h"
 
@@ -88,80 +87,48 @@ class Mac {
     std::vector<Eigen::Vector3d> v_;
 };
 
-using Sparse = Eigen::SparseMatrix<double>;
-
 // Implicit diffusion of component a (4.23): (1 - dt nu Laplacian) u2 = u1 on the inner
-// faces; faces on or beyond the walls are zero.
-int diffuse(Mac& u, int a, double dtNu, double tolerance) {
+// faces; faces on or beyond the walls are zero. The inner faces of component a run from 1 to
+// n - 1 along a (the walls at 0 and n hold zero) and from 0 to n - 1 across (zero beyond).
+void diffuse(Mac& u, int a, double dtNu) {
     const int n = u.n();
-    std::vector<int> number(u.values().size(), -1);
-    std::vector<std::array<int, 3>> faces;
-    for (int k = 0; k <= n; ++k)
-        for (int j = 0; j <= n; ++j)
-            for (int i = 0; i <= n; ++i)
-                if (u.inner(a, i, j, k)) {
-                    number[u.index(i, j, k)] = int(faces.size());
-                    faces.push_back({i, j, k});
-                }
-    std::vector<Eigen::Triplet<double>> entries;
-    Eigen::VectorXd b(faces.size());
-    for (std::size_t f = 0; f < faces.size(); ++f) {
-        const auto [i, j, k] = faces[f];
-        entries.emplace_back(int(f), int(f), 1.0 + 6.0 * dtNu);
-        const int d[6][3] = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-        for (const auto& o : d)
-            if (u.inner(a, i + o[0], j + o[1], k + o[2]))
-                entries.emplace_back(int(f), number[u.index(i + o[0], j + o[1], k + o[2])], -dtNu);
-        b[Eigen::Index(f)] = u.get(a, i, j, k);
-    }
-    Sparse A(Eigen::Index(faces.size()), Eigen::Index(faces.size()));
-    A.setFromTriplets(entries.begin(), entries.end());
-    Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper> cg(A);
-    cg.setTolerance(tolerance);
-    const Eigen::VectorXd x = cg.solve(b);
-    for (std::size_t f = 0; f < faces.size(); ++f)
-        u.at(a, faces[f][0], faces[f][1], faces[f][2]) = x[Eigen::Index(f)];
-    return int(cg.iterations());
+    BoxProblem box;
+    box.dims = {n, n, n};
+    box.dims[a] = n - 1;
+    box.ends = {BoxEnds::Zero, BoxEnds::Zero, BoxEnds::Zero};
+    box.shift = 1.0;
+    box.scale = dtNu;
+    const int lo[3] = {a == 0, a == 1, a == 2};
+    std::vector<double> x(box.size());
+    std::size_t f = 0;
+    for (int k = 0; k < box.dims[2]; ++k)
+        for (int j = 0; j < box.dims[1]; ++j)
+            for (int i = 0; i < box.dims[0]; ++i)
+                x[f++] = u.get(a, i + lo[0], j + lo[1], k + lo[2]);
+    solveBox(box, x);
+    f = 0;
+    for (int k = 0; k < box.dims[2]; ++k)
+        for (int j = 0; j < box.dims[1]; ++j)
+            for (int i = 0; i < box.dims[0]; ++i)
+                u.at(a, i + lo[0], j + lo[1], k + lo[2]) = x[f++];
 }
 
 // The projection (4.24, 4.25): -Laplacian p = -div u2 / dt on the cells, no flow through the
 // walls (Neumann), then u3 = u2 - dt grad p on the inner faces. The Neumann problem fixes p
-// up to a constant: cell 0 is held at 0, and since the divergences sum to zero (nothing
-// crosses the walls) its own equation then holds too.
-int project(Mac& u, double dt, double tolerance) {
+// up to a constant (the solve takes the one of zero mean); its right-hand side sums to zero
+// since nothing crosses the walls.
+void project(Mac& u, double dt) {
     const int n = u.n();
     auto cell = [n](int i, int j, int k) { return i + n * (j + n * k); };
-    const Eigen::Index cells = Eigen::Index(n) * n * n;
-    std::vector<Eigen::Triplet<double>> entries;
-    Eigen::VectorXd b(cells);
+    std::vector<double> p(std::size_t(n) * n * n);
     for (int k = 0; k < n; ++k)
         for (int j = 0; j < n; ++j)
-            for (int i = 0; i < n; ++i) {
-                const int c = cell(i, j, k);
-                if (c == 0) {
-                    entries.emplace_back(0, 0, 1.0);
-                    b[0] = 0.0;
-                    continue;
-                }
-                int neighbours = 0;
-                const int d[6][3] = {{1, 0, 0},  {-1, 0, 0}, {0, 1, 0},
-                                     {0, -1, 0}, {0, 0, 1},  {0, 0, -1}};
-                for (const auto& o : d) {
-                    const int x = i + o[0], y = j + o[1], z = k + o[2];
-                    if (x < 0 || y < 0 || z < 0 || x >= n || y >= n || z >= n) continue;
-                    ++neighbours;
-                    if (cell(x, y, z) != 0) entries.emplace_back(c, cell(x, y, z), -1.0);
-                }
-                entries.emplace_back(c, c, double(neighbours));
-                b[c] = -u.divergence(i, j, k) / dt;
-            }
-    Sparse A(cells, cells);
-    A.setFromTriplets(entries.begin(), entries.end());
-    // Jacobi preconditioning (Eigen's default): at 72^3 cells the whole solve took 4.6 s and
-    // 664 iterations, where the incomplete Cholesky the thesis cites took 432 in 14 s.
-    Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper> cg(A);
-    cg.setTolerance(tolerance);
-    const Eigen::VectorXd p = cg.solve(b);
+            for (int i = 0; i < n; ++i)
+                p[cell(i, j, k)] = -u.divergence(i, j, k) / dt;
+    BoxProblem box;
+    box.dims = {n, n, n};
+    box.ends = {BoxEnds::Closed, BoxEnds::Closed, BoxEnds::Closed};
+    solveBox(box, p);
     for (int a = 0; a < 3; ++a)
         for (int k = 0; k < n; ++k)
             for (int j = 0; j < n; ++j)
@@ -171,7 +138,6 @@ int project(Mac& u, double dt, double tolerance) {
                     --o[a];
                     u.at(a, i, j, k) -= dt * (p[cell(i, j, k)] - p[cell(o[0], o[1], o[2])]);
                 }
-    return int(cg.iterations());
 }
 
 } // namespace
@@ -181,8 +147,8 @@ FluidSolution solveSweptFluid(const FluidSpec& spec) {
     if (n < 8 || n > 512) throw std::invalid_argument("the fluid grid needs 8 to 512 cells a side");
     if (!(spec.ballRadius > 0.0) || !(spec.ballRadius <= n / 4.0))
         throw std::invalid_argument("the fluid's ball must fit in the middle half of its grid");
-    if (!(spec.viscosity >= 0.0) || !(spec.timeStep > 0.0) || !(spec.tolerance > 0.0))
-        throw std::invalid_argument("the fluid needs a viscosity, a time step and a tolerance");
+    if (!(spec.viscosity >= 0.0) || !(spec.timeStep > 0.0))
+        throw std::invalid_argument("the fluid needs a viscosity and a time step");
     const double dt = spec.timeStep;
     const Eigen::Vector3d centre = Eigen::Vector3d::Constant(0.5 * n);
     // v0: the faces inside the ball move with the tool, v_INIT = (1, 0, 0).
@@ -207,11 +173,10 @@ FluidSolution solveSweptFluid(const FluidSpec& spec) {
                     if ((g - centre).cwiseAbs().maxCoeff() > reach) continue;
                     u.at(a, i, j, k) = v0.sample(a, g - dt * v0.velocity(g), true);
                 }
-    FluidSolution out;
     for (int a = 0; a < 3; ++a)
-        out.diffusionIterations =
-            std::max(out.diffusionIterations, diffuse(u, a, dt * spec.viscosity, spec.tolerance));
-    out.pressureIterations = project(u, dt, spec.tolerance);
+        diffuse(u, a, dt * spec.viscosity);
+    project(u, dt);
+    FluidSolution out;
     for (int k = 0; k < n; ++k)
         for (int j = 0; j < n; ++j)
             for (int i = 0; i < n; ++i)

@@ -21,7 +21,7 @@ namespace sweepers {
 namespace {
 
 // Bumped when the solver changes what it computes, so older cache files are solved again.
-constexpr int kSolverVersion = 1;
+constexpr int kSolverVersion = 2; // 2: the exact solves of the diffusion and the pressure
 
 std::string cacheDirectory() {
     if (const char* d = std::getenv("SWEEPERS_CACHE"); d && *d) return d;
@@ -37,7 +37,6 @@ openvdb::MetaMap describe(const FluidSpec& spec) {
     meta.insertMeta("fluid_ball_radius", openvdb::DoubleMetadata(spec.ballRadius));
     meta.insertMeta("fluid_viscosity", openvdb::DoubleMetadata(spec.viscosity));
     meta.insertMeta("fluid_time_step", openvdb::DoubleMetadata(spec.timeStep));
-    meta.insertMeta("fluid_tolerance", openvdb::DoubleMetadata(spec.tolerance));
     return meta;
 }
 
@@ -63,12 +62,10 @@ std::string fluidCachePath(const FluidSpec& spec) {
 
 std::shared_ptr<const SweptFluid> sweptFluid(const FluidSpec& spec, std::string* said) {
     static std::mutex lock;
-    static std::map<std::tuple<int, double, double, double, double>,
-                    std::shared_ptr<const SweptFluid>>
+    static std::map<std::tuple<int, double, double, double>, std::shared_ptr<const SweptFluid>>
         solved;
     const std::lock_guard<std::mutex> hold(lock);
-    const auto key =
-        std::make_tuple(spec.cells, spec.ballRadius, spec.viscosity, spec.timeStep, spec.tolerance);
+    const auto key = std::make_tuple(spec.cells, spec.ballRadius, spec.viscosity, spec.timeStep);
     if (auto it = solved.find(key); it != solved.end()) {
         if (said) *said = "the swept fluid was found earlier in this run";
         return it->second;
