@@ -14,13 +14,13 @@ namespace {
 struct Basis {
     int m;
     std::vector<double> to;   // m x m, row-major: coordinates = to * values
-    std::vector<double> from; // its transpose and inverse: values = from * coordinates
+    std::vector<double> from; // its transpose and inverse (kept so that both read rows)
     std::vector<double> eigen;
 
     Basis(int size, BoxEnds ends)
         : m(size), to(std::size_t(m) * m), from(std::size_t(m) * m), eigen(std::size_t(m)) {
+        const bool closed = ends == BoxEnds::Closed;
         for (int k = 0; k < m; ++k) {
-            const bool closed = ends == BoxEnds::Closed;
             const double theta = closed ? M_PI * k / m : M_PI * (k + 1) / (m + 1);
             const double norm =
                 closed ? std::sqrt((k == 0 ? 1.0 : 2.0) / m) : std::sqrt(2.0 / (m + 1));

@@ -98,19 +98,19 @@ void diffuse(Mac& u, int a, double dtNu) {
     box.ends = {BoxEnds::Zero, BoxEnds::Zero, BoxEnds::Zero};
     box.shift = 1.0;
     box.scale = dtNu;
+    // The box's cells in order (x fastest), as the faces they are.
     const int lo[3] = {a == 0, a == 1, a == 2};
+    const auto eachFace = [&](const auto& visit) {
+        std::size_t f = 0;
+        for (int k = 0; k < box.dims[2]; ++k)
+            for (int j = 0; j < box.dims[1]; ++j)
+                for (int i = 0; i < box.dims[0]; ++i)
+                    visit(f++, i + lo[0], j + lo[1], k + lo[2]);
+    };
     std::vector<double> x(box.size());
-    std::size_t f = 0;
-    for (int k = 0; k < box.dims[2]; ++k)
-        for (int j = 0; j < box.dims[1]; ++j)
-            for (int i = 0; i < box.dims[0]; ++i)
-                x[f++] = u.get(a, i + lo[0], j + lo[1], k + lo[2]);
+    eachFace([&](std::size_t f, int i, int j, int k) { x[f] = u.get(a, i, j, k); });
     solveBox(box, x);
-    f = 0;
-    for (int k = 0; k < box.dims[2]; ++k)
-        for (int j = 0; j < box.dims[1]; ++j)
-            for (int i = 0; i < box.dims[0]; ++i)
-                u.at(a, i + lo[0], j + lo[1], k + lo[2]) = x[f++];
+    eachFace([&](std::size_t f, int i, int j, int k) { u.at(a, i, j, k) = x[f]; });
 }
 
 // The projection (4.24, 4.25): -Laplacian p = -div u2 / dt on the cells, no flow through the
