@@ -7,6 +7,8 @@
 #include <Eigen/Core>
 #include <openvdb/openvdb.h>
 
+#include "levelset/vdb_instances.h"
+
 namespace sweepers {
 
 using Grid = openvdb::FloatGrid;
