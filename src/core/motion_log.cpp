@@ -24,7 +24,7 @@ MotionLog::Kind join(MotionLog::Kind a, MotionLog::Kind b) {
     if (a == K::General || b == K::General) return K::General;
     if (a == K::Translation) return b;
     if (b == K::Translation) return a;
-    return K::General; // twist + dilation
+    return K::General; // twist + dilation, a scale along an axis + anything but itself
 }
 
 } // namespace
@@ -73,6 +73,17 @@ MotionLog MotionLog::fromMatrix(const Eigen::Matrix4d& L) {
             (l.linear_ - alpha * Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= tol;
         if (dilation) l.linear_ = alpha * Eigen::Matrix3d::Identity();
         l.kind_ = dilation ? Kind::Dilation : Kind::General;
+        // a n n^T (A.3)? Its column through the largest diagonal entry a n_i^2 is a n_i n,
+        // the longest multiple of n among its columns, so the least spoilt by rounding.
+        int i = 0;
+        l.linear_.diagonal().cwiseAbs().maxCoeff(&i);
+        const Eigen::Vector3d n = l.linear_.col(i).normalized();
+        const double a = n.dot(l.linear_ * n);
+        if (!dilation && (l.linear_ - a * n * n.transpose()).cwiseAbs().maxCoeff() <= tol) {
+            l.linear_ = a * n * n.transpose();
+            l.axis_ = n;
+            l.kind_ = Kind::AxisScale;
+        }
     }
     return l;
 }
@@ -144,6 +155,13 @@ Eigen::Matrix4d MotionLog::exp() const {
         E.topRightCorner<3, 1>() = expm1OverX(a) * u_;
         return E;
     }
+    case Kind::AxisScale: { // as applyExp below
+        const double a = axis_.dot(linear_ * axis_);
+        Eigen::Matrix4d E = Eigen::Matrix4d::Identity();
+        E.topLeftCorner<3, 3>() += std::expm1(a) * axis_ * axis_.transpose();
+        E.topRightCorner<3, 1>() = u_ + (expm1OverX(a) - 1.0) * axis_.dot(u_) * axis_;
+        return E;
+    }
     case Kind::General:
         break;
     }
@@ -162,6 +180,15 @@ Eigen::Vector3d MotionLog::applyExp(const Eigen::Vector3d& p) const {
         const double a = linear_(0, 0);
         return std::exp(a) * p + expm1OverX(a) * u_;
     }
+    case Kind::AxisScale: {
+        // L = a n n^T with (n n^T)^2 = n n^T, so exp(t L) = I + (e^{ta} - 1) n n^T, and the
+        // translation is the integral of that over t in [0, 1] applied to u. For u = -a
+        // (c.n) n this is 3.27's sub-step p + (e^a - 1) ((p - c).n) n; u is any vector
+        // here, since a blend adds translations.
+        const double a = axis_.dot(linear_ * axis_);
+        return p + u_ +
+               (std::expm1(a) * axis_.dot(p) + (expm1OverX(a) - 1.0) * axis_.dot(u_)) * axis_;
+    }
     case Kind::General:
         break;
     }
@@ -174,6 +201,12 @@ MotionLog MotionLog::operator+(const MotionLog& o) const {
     r.linear_ = linear_ + o.linear_;
     r.u_ = u_ + o.u_;
     r.kind_ = join(kind_, o.kind_);
+    // Scales along one axis add up to a scale along it (one tool's log blended with itself);
+    // along two axes they do not.
+    if (kind_ == Kind::AxisScale && o.kind_ == Kind::AxisScale && axis_ != o.axis_ &&
+        axis_ != -o.axis_)
+        r.kind_ = Kind::General;
+    r.axis_ = kind_ == Kind::AxisScale ? axis_ : o.axis_;
     return r;
 }
 

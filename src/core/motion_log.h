@@ -6,11 +6,13 @@
 //   Translation  linear block 0                       exp: p + u              (A.1)
 //   Twist        linear block skew (rigid motion)     exp: 7.29
 //   Dilation     linear block alpha I (uniform scale) exp: e^a p + (e^a-1)/a u (A.2)
+//   AxisScale    linear block a n n^T (scale along    exp: p + (e^a-1) n n.p + u
+//                one axis, A.3)                            + ((e^a-1)/a - 1) n n.u
 //   General      anything else (blended twist+scale,  exp: Pade matrix exponential
-//                non-uniform scales, mixed motions)
+//                scales along several axes, mixed motions)
 //
-// Sums keep the narrowest family both terms share, so a blend of rigid motions stays on
-// the fast closed form.
+// Sums keep the narrowest family both terms share, so a blend of rigid motions, or of
+// scales along one axis, stays on the fast closed form.
 #pragma once
 
 #include <Eigen/Core>
@@ -21,7 +23,7 @@ namespace sweepers {
 
 class MotionLog {
   public:
-    enum class Kind { Translation = 0, Twist = 1, Dilation = 2, General = 3 };
+    enum class Kind { Translation, Twist, Dilation, AxisScale, General };
 
     MotionLog() = default;
     MotionLog(const Twist& t);
@@ -46,6 +48,8 @@ class MotionLog {
     const Eigen::Vector3d& translationPart() const { return u_; }
     // The twist <omega, m>; only meaningful for kinds Translation and Twist.
     Twist twist() const;
+    // The unit axis n of the linear block a n n^T; only meaningful for kind AxisScale.
+    const Eigen::Vector3d& axis() const { return axis_; }
 
     Eigen::Matrix4d matrix() const;
     Eigen::Matrix4d exp() const;
@@ -68,6 +72,7 @@ class MotionLog {
   private:
     Eigen::Matrix3d linear_ = Eigen::Matrix3d::Zero();
     Eigen::Vector3d u_ = Eigen::Vector3d::Zero();
+    Eigen::Vector3d axis_ = Eigen::Vector3d::Zero();
     Kind kind_ = Kind::Translation;
 };
 

@@ -56,9 +56,16 @@ TEST(MotionLog, NonUniformScaleLogsMatchAppendixA3) {
         const Eigen::Matrix4d M = axisScaleAbout(s, n, c);
         const MotionLog closed = MotionLog::axisScale(s, n, c);
         const MotionLog fromM = MotionLog::log(M);
+        EXPECT_EQ(closed.kind(), MotionLog::Kind::AxisScale);
+        EXPECT_EQ(fromM.kind(), MotionLog::Kind::AxisScale);
         EXPECT_LT(maxDiff(closed.matrix(), fromM.matrix()), 1e-10);
         EXPECT_LT(maxDiff(closed.exp(), M), 1e-9);
         EXPECT_LT(maxDiff(seriesExp(fromM.matrix()), M), 1e-9);
+        // 3.27: a fraction w of the sub-step moves p by (s^w - 1) ((p - c).n) n.
+        const double w = rng.uniform(-1, 1);
+        const Eigen::Vector3d p = rng.vec(-3, 3);
+        const Eigen::Vector3d expected = p + (std::pow(s, w) - 1) * (p - c).dot(n) * n;
+        EXPECT_LT((fromM.applyExp(w, p) - expected).norm(), 1e-12);
     }
 }
 
@@ -85,15 +92,22 @@ TEST(MotionLog, KindsJoinAndApplyExpMatchesTheMatrix) {
     const MotionLog t = MotionLog::translation({1, 0, 0});
     const MotionLog r = Twist::rotation({0, 0, 1}, 0.5, {1, 1, 0});
     const MotionLog d = MotionLog::uniformScale(1.5, {0, 1, 0});
-    const MotionLog a = MotionLog::axisScale(0.7, {1, 0, 0}, {0, 0, 0});
     EXPECT_EQ((t + t).kind(), MotionLog::Kind::Translation);
     EXPECT_EQ((t + r).kind(), MotionLog::Kind::Twist);
     EXPECT_EQ((t + d).kind(), MotionLog::Kind::Dilation);
     EXPECT_EQ((r + d).kind(), MotionLog::Kind::General);
-    EXPECT_EQ(a.kind(), MotionLog::Kind::General);
+    const MotionLog a = MotionLog::axisScale(0.7, Eigen::Vector3d(1, 2, -2), {0.5, 0, 1});
+    const MotionLog b = MotionLog::axisScale(1.3, {0, 1, 0}, {0, 0, 0});
+    EXPECT_EQ(a.kind(), MotionLog::Kind::AxisScale);
+    EXPECT_EQ((t * 0.3 + a * 0.5).kind(), MotionLog::Kind::AxisScale);
+    EXPECT_EQ((a * 0.4 + a * -1.5).kind(), MotionLog::Kind::AxisScale);
+    EXPECT_EQ((a + b).kind(), MotionLog::Kind::General);
+    EXPECT_EQ((a + d).kind(), MotionLog::Kind::General);
+    EXPECT_EQ((t * 0.3 + r * 0.2 + a * 0.5).kind(), MotionLog::Kind::General);
     Rng rng(24);
-    for (const MotionLog& L :
-         {t, r, d, a, MotionLog(r + d), MotionLog(t * 0.3 + r * 0.2 + a * 0.5)}) {
+    for (const MotionLog& L : {t, r, d, a, b, MotionLog(r + d), MotionLog(t * 0.3 + a * 0.5),
+                               MotionLog(a + b), MotionLog(a * 0.4 + a * -1.5),
+                               MotionLog(a * 1e-9 + t), MotionLog(t * 0.3 + r * 0.2 + a * 0.5)}) {
         const Eigen::Matrix4d E = seriesExp(L.matrix());
         EXPECT_LT(maxDiff(L.exp(), E), 1e-12);
         for (int i = 0; i < 20; ++i) {
