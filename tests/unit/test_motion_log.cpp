@@ -104,10 +104,16 @@ TEST(MotionLog, KindsJoinAndApplyExpMatchesTheMatrix) {
     EXPECT_EQ((a + b).kind(), MotionLog::Kind::General);
     EXPECT_EQ((a + d).kind(), MotionLog::Kind::General);
     EXPECT_EQ((t * 0.3 + r * 0.2 + a * 0.5).kind(), MotionLog::Kind::General);
+    // Rank one but not symmetric: shears along n (a n m^T) are no scale along an axis.
+    Eigen::Matrix4d shear = Eigen::Matrix4d::Zero();
+    shear.topLeftCorner<3, 3>() = Eigen::Vector3d(0, 0, 1) * Eigen::RowVector3d(0.3, 0, 0.5);
+    const MotionLog sheared = MotionLog::fromMatrix(shear);
+    EXPECT_EQ(sheared.kind(), MotionLog::Kind::General);
     Rng rng(24);
-    for (const MotionLog& L : {t, r, d, a, b, MotionLog(r + d), MotionLog(t * 0.3 + a * 0.5),
-                               MotionLog(a + b), MotionLog(a * 0.4 + a * -1.5),
-                               MotionLog(a * 1e-9 + t), MotionLog(t * 0.3 + r * 0.2 + a * 0.5)}) {
+    for (const MotionLog& L :
+         {t, r, d, a, b, MotionLog(r + d), MotionLog(t * 0.3 + a * 0.5), MotionLog(a + b),
+          MotionLog(a * 0.4 + a * -1.5), MotionLog(a * 1e-9 + t),
+          MotionLog(t * 0.3 + r * 0.2 + a * 0.5), sheared}) {
         const Eigen::Matrix4d E = seriesExp(L.matrix());
         EXPECT_LT(maxDiff(L.exp(), E), 1e-12);
         for (int i = 0; i < 20; ++i) {
