@@ -10,6 +10,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <map>
 #include <utility>
 #include <vector>
 
@@ -403,6 +404,43 @@ void makeLeavesWithin(Grid& grid, const openvdb::MaskTree& mask, int beyond,
         }
 }
 
+// How many voxels (face steps) the band of each of `leaves` is to be widened by. A stretch s
+// measured at interface voxel x (one in kStretchSampling is measured; the stretch varies
+// smoothly, as the widening of the whole box by the largest one assumed too) asks for a band
+// of n = needed(s) voxels: the pre-images of the voxels next to the new surface near x's
+// image lie within n voxels of x, and the band voxels nearest them within n more. So every
+// leaf within 2n voxels of x's leaf has its band widened to n.
+template <typename Needed>
+std::vector<int>
+widening(const std::vector<const LeafNode*>& leaves, const std::vector<openvdb::Coord>& interface,
+         const std::vector<double>& stretchAt, const Needed& needed, double halfWidth) {
+    constexpr int kDim = int(LeafNode::DIM);
+    std::map<openvdb::Coord, double> asks; // by the leaf the measured voxel lies in
+    for (std::size_t k = 0; k < stretchAt.size() && k * kStretchSampling < interface.size(); ++k) {
+        const double n = needed(stretchAt[k]);
+        if (n <= halfWidth) continue;
+        double& a = asks[interface[k * kStretchSampling] & ~(kDim - 1)];
+        a = std::max(a, n);
+    }
+    // Every leaf against every asking one: the pairs are few where a stretch is local (some
+    // 300 leaves against a few dozen in a needle segment at 1/128).
+    std::vector<int> by(leaves.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
+        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const openvdb::Coord o = leaves[l]->origin();
+            for (const auto& [from, n] : asks) {
+                // The gap between the two leaves in voxels, along the axis they lie farthest
+                // apart.
+                const openvdb::Coord d = o - from;
+                const int gap =
+                    std::max({std::abs(d.x()), std::abs(d.y()), std::abs(d.z())}) - kDim;
+                if (gap <= 2 * int(n)) by[l] = std::max(by[l], int(std::ceil(n - halfWidth)));
+            }
+        }
+    });
+    return by;
+}
+
 } // namespace
 
 openvdb::CoordBBox changedRegion(const Grid& grid, const StepDeformation& seg) {
@@ -481,11 +519,11 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     tbb::enumerable_thread_specific<openvdb::MaskTree::Ptr> marks(
         [] { return std::make_shared<openvdb::MaskTree>(); });
     const VoxelPlacement place(grid.transform());
-    tbb::enumerable_thread_specific<double> stretch(1.0);
+    // The stretch at every kStretchSampling-th interface voxel (1 where not measured).
+    std::vector<double> stretchAt(interface.size() / kStretchSampling + 1, 1.0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
         pollInterrupt(options.interrupter);
         openvdb::tree::ValueAccessor<openvdb::MaskTree, false> m(*marks.local());
-        double& worst = stretch.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             Eigen::Vector3d p = toEigen(place.toWorld(interface[i].asVec3d()));
             for (int k = 0; k < seg.steps(); ++k) {
@@ -507,7 +545,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             // iterative SVD of J cost more than the six inverse maps).
             Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
             eigen.computeDirect(J.transpose() * J, Eigen::EigenvaluesOnly);
-            worst = std::max(worst, std::sqrt(std::max(0.0, eigen.eigenvalues()[2])));
+            stretchAt[i / kStretchSampling] = std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
         }
     });
     openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create();
@@ -534,14 +572,14 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // the middle of the opening, so the inside voxels there join the band to be sampled
     // (renormalization drops them again, with their new sign).
     if (seg.tears()) stats.tornVoxels = markOpened(grid, seg, (halfWidth + 2) * h, *mask);
-    double maxStretch = 1.0;
-    for (double s : stretch)
-        maxStretch = std::max(maxStretch, s);
     // The voxels the renormalization seeds from lie within 1.5 voxels of the new surface
     // (crossing ends and their central differences); their pre-images lie within
     // 1.5 * stretch voxels of the old one, and trilinear sampling reads one voxel beyond.
     // Make sure the old band reaches that far, so none of them reads a clamped value.
-    const double needed = std::ceil(1.5 * std::min(maxStretch, 32.0) + 1.0);
+    const auto neededFor = [](double stretch) {
+        return std::ceil(1.5 * std::min(stretch, 32.0) + 1.0);
+    };
+    const double needed = neededFor(*std::max_element(stretchAt.begin(), stretchAt.end()));
     stats.widenedTo = std::max(halfWidth, needed);
     GridPtr widened; // the copies with the widened band, when it had to be widened
     if (needed > halfWidth) {
@@ -553,12 +591,23 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         GridPtr source = SampleSource::copyLeaves(grid, leaves);
         stats.leavesCopied += leaves.size();
         openvdb::tools::changeLevelSetBackground(source->tree(), float(needed * h));
-        openvdb::MaskGrid::Ptr widen = openvdb::MaskGrid::create();
-        for (const LeafNode* leaf : leaves)
-            widen->tree().touchLeaf(leaf->origin())->topologyUnion(*leaf);
-        openvdb::tools::dilateActiveValues(widen->tree(), int(std::ceil(needed - halfWidth)),
-                                           openvdb::tools::NN_FACE, openvdb::tools::IGNORE_TILES);
-        source->tree().topologyUnion(widen->tree());
+        // A stretch is strong only near where a tool tears or squeezes (the tips of the pinch's
+        // needles, the noose): the band is widened as far as the stretch measured near each
+        // leaf asks, and not at all where none asks (in a needle segment of the first pinch of
+        // data/two_handles.json at 1/128, some 300 leaves of band lie in the box, and a dozen
+        // ask for more than the band holds).
+        const std::vector<int> by = widening(leaves, interface, stretchAt, neededFor, halfWidth);
+        std::map<int, openvdb::MaskTree> widen; // the leaves to widen, by how far
+        for (std::size_t l = 0; l < leaves.size(); ++l) {
+            if (by[l] == 0) continue;
+            widen[by[l]].touchLeaf(leaves[l]->origin())->topologyUnion(*leaves[l]);
+            ++stats.leavesWidened;
+        }
+        for (auto& [steps, mask] : widen) {
+            openvdb::tools::dilateActiveValues(mask, steps, openvdb::tools::NN_FACE,
+                                               openvdb::tools::IGNORE_TILES);
+            source->tree().topologyUnion(mask);
+        }
         // Leaves the dilation added hold the copies' background, whatever the side.
         const auto live = grid.getConstAccessor();
         for (LeafNode* leaf : leavesIn(source->tree(), box))

@@ -13,8 +13,8 @@
 // could send the pre-image of a voxel next to the new surface outside the old band, where
 // the old grid only holds +-background: the source band is then widened first (by fast
 // marching, inside the affected box) to cover the stretch of the inverse map, measured on
-// the forward-mapped interface. After sampling, inactive signs are re-derived by flood
-// fill and the box is renormalized.
+// the forward-mapped interface, around the leaves where it was measured. After sampling, inactive
+// signs are re-derived by flood fill and the box is renormalized.
 #pragma once
 
 #include "deform/step_deformation.h"
@@ -45,6 +45,7 @@ struct AdvectStats {
     std::size_t voxelsVisited = 0; // scanned for the interface, sampled, marched over
     std::size_t leavesVisited = 0; // leaves those loops went through
     std::size_t leavesCopied = 0;  // copied as the sampling source
+    std::size_t leavesWidened = 0; // of those, whose band a stretch asked to be widened
     std::size_t leavesFlooded = 0; // whose inactive signs were re-derived
     std::size_t tornVoxels = 0;    // inside voxels beyond the band that a tear opened
     double growSeconds = 0.0, sampleSeconds = 0.0, renormalizeSeconds = 0.0;

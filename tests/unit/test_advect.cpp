@@ -7,6 +7,7 @@
 #include <openvdb/tools/Composite.h>
 
 #include "deform/inflate.h"
+#include "deform/pinch.h"
 #include "grids.h"
 #include "io/start_grid.h"
 #include "io/stroke_script.h"
@@ -143,6 +144,42 @@ TEST(Advect, TheBandIsWidenedByTheLargestStretch) {
     EXPECT_EQ(stats.widenedTo, 5.0);
     const LevelSetMeasures m = measureLevelSet(*g);
     EXPECT_NEAR(m.volume, 0.4 * 4.0 / 3.0 * M_PI, 0.01 * 0.4 * 4.0 / 3.0 * M_PI);
+}
+
+// The band is widened only where a stretch asks: the needles of a pinch stretch space near
+// their tips alone, and the band of the leaves far from them in the box (which spans both
+// tips) is left as it is. (At 1/32 the tips are a few leaves apart: 124 of 232 leaves.)
+TEST(Advect, TheBandIsWidenedOnlyWhereTheStretchAsks) {
+    const double h = 1.0 / 32;
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+    PinchSpec spec;
+    spec.axis = Eigen::Vector3d::UnitY();
+    spec.size = 1.1;
+    spec.falloff = 0.3;
+    spec.open = 0.15;
+    const auto parts = planPinch(spec, h);
+    bool widened = false;
+    for (std::size_t j = 0; j + 1 < parts.size() && !widened; ++j) {
+        const GridPtr before = g->deepCopy();
+        const AdvectStats stats = advectSegment(*g, *parts[j]);
+        if (stats.widenedTo <= 3.0) {
+            EXPECT_EQ(stats.leavesWidened, 0u);
+            continue;
+        }
+        widened = true;
+        // The band's leaves the widening copied: those of the box grown by the width.
+        const openvdb::CoordBBox box =
+            indexBox(*before, parts[j]->affectedBox(), int(stats.widenedTo) + 3);
+        std::size_t inBox = 0;
+        for (auto leaf = before->tree().cbeginLeaf(); leaf; ++leaf)
+            inBox += box.hasOverlap(leaf->getNodeBoundingBox());
+        std::printf("[ advect ] needle segment %zu at 1/32: band widened to %g voxels in %zu of "
+                    "the %zu leaves in its box\n",
+                    j, stats.widenedTo, stats.leavesWidened, inBox);
+        EXPECT_GT(stats.leavesWidened, 0u);
+        EXPECT_LT(stats.leavesWidened, inBox);
+    }
+    EXPECT_TRUE(widened);
 }
 
 // Sampling reaches two voxels around the images of the surface, what renormalization's seeds
