@@ -71,15 +71,19 @@ MotionLog MotionLog::fromMatrix(const Eigen::Matrix4d& L) {
         const double alpha = l.linear_.trace() / 3.0;
         const bool dilation =
             (l.linear_ - alpha * Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <= tol;
-        if (dilation) l.linear_ = alpha * Eigen::Matrix3d::Identity();
-        l.kind_ = dilation ? Kind::Dilation : Kind::General;
+        if (dilation) {
+            l.linear_ = alpha * Eigen::Matrix3d::Identity();
+            l.kind_ = Kind::Dilation;
+            return l;
+        }
         // a n n^T (A.3)? Its column through the largest diagonal entry a n_i^2 is a n_i n,
         // the longest multiple of n among its columns, so the least spoilt by rounding.
         int i = 0;
         l.linear_.diagonal().cwiseAbs().maxCoeff(&i);
         const Eigen::Vector3d n = l.linear_.col(i).normalized();
         const double a = n.dot(l.linear_ * n);
-        if (!dilation && (l.linear_ - a * n * n.transpose()).cwiseAbs().maxCoeff() <= tol) {
+        l.kind_ = Kind::General;
+        if ((l.linear_ - a * n * n.transpose()).cwiseAbs().maxCoeff() <= tol) {
             l.linear_ = a * n * n.transpose();
             l.axis_ = n;
             l.kind_ = Kind::AxisScale;

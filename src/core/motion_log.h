@@ -48,8 +48,6 @@ class MotionLog {
     const Eigen::Vector3d& translationPart() const { return u_; }
     // The twist <omega, m>; only meaningful for kinds Translation and Twist.
     Twist twist() const;
-    // The unit axis n of the linear block a n n^T; only meaningful for kind AxisScale.
-    const Eigen::Vector3d& axis() const { return axis_; }
 
     Eigen::Matrix4d matrix() const;
     Eigen::Matrix4d exp() const;
@@ -72,7 +70,7 @@ class MotionLog {
   private:
     Eigen::Matrix3d linear_ = Eigen::Matrix3d::Zero();
     Eigen::Vector3d u_ = Eigen::Vector3d::Zero();
-    Eigen::Vector3d axis_ = Eigen::Vector3d::Zero();
+    Eigen::Vector3d axis_ = Eigen::Vector3d::Zero(); // the unit n of a n n^T (AxisScale)
     Kind kind_ = Kind::Translation;
 };
 

@@ -13,8 +13,8 @@
 // could send the pre-image of a voxel next to the new surface outside the old band, where
 // the old grid only holds +-background: the source band is then widened first (by fast
 // marching, inside the affected box) to cover the stretch of the inverse map, measured on
-// the forward-mapped interface, around the leaves where it was measured. After sampling, inactive
-// signs are re-derived by flood fill and the box is renormalized.
+// the forward-mapped interface, around the leaves where it was measured. After sampling,
+// inactive signs are re-derived by flood fill and the box is renormalized.
 #pragma once
 
 #include "deform/step_deformation.h"
