@@ -24,7 +24,7 @@ MotionLog::Kind join(MotionLog::Kind a, MotionLog::Kind b) {
     if (a == K::General || b == K::General) return K::General;
     if (a == K::Translation) return b;
     if (b == K::Translation) return a;
-    return K::General; // twist + dilation, a scale along an axis + anything but itself
+    return K::General; // twist + dilation, a scale along an axis + a twist or a dilation
 }
 
 } // namespace

@@ -148,7 +148,7 @@ TEST(Advect, TheBandIsWidenedByTheLargestStretch) {
 
 // The band is widened only where a stretch asks: the needles of a pinch stretch space near
 // their tips alone, and the band of the leaves far from them in the box (which spans both
-// tips) is left as it is. (At 1/32 the tips are a few leaves apart: 124 of 232 leaves.)
+// tips) is left as it is (at 1/32, 124 of the box's 232 leaves are widened).
 TEST(Advect, TheBandIsWidenedOnlyWhereTheStretchAsks) {
     const double h = 1.0 / 32;
     GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
