@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <map>
 #include <stdexcept>
@@ -32,7 +33,7 @@ int keyCode(const std::string& k) {
 
 } // namespace
 
-std::vector<InputEvent> readInputEvents(const std::string& path) {
+InputReplay readInputReplay(const std::string& path) {
     std::ifstream in(path);
     if (!in) throw std::runtime_error(path + ": cannot open");
     nlohmann::json doc;
@@ -43,7 +44,19 @@ std::vector<InputEvent> readInputEvents(const std::string& path) {
     }
     if (!doc.is_object() || !doc.contains("events") || !doc["events"].is_array())
         throw std::runtime_error(path + ": expected {\"events\": [...]}");
-    std::vector<InputEvent> out;
+    InputReplay out;
+    if (doc.contains("window")) {
+        const auto& w = doc["window"];
+        const auto pixels = [](const nlohmann::json& v) {
+            return v.is_number_integer() && v.get<std::int64_t>() >= 64 &&
+                   v.get<std::int64_t>() <= 8192;
+        };
+        if (!w.is_array() || w.size() != 2 || !pixels(w[0]) || !pixels(w[1]))
+            throw std::runtime_error(path + ": /window: expected [width, height] in pixels, "
+                                            "64 to 8192 each, like [640, 480]");
+        out.width = w[0].get<int>();
+        out.height = w[1].get<int>();
+    }
     int lastFrame = 0;
     for (std::size_t i = 0; i < doc["events"].size(); ++i) {
         const auto& e = doc["events"][i];
@@ -91,7 +104,7 @@ std::vector<InputEvent> readInputEvents(const std::string& path) {
             } else {
                 throw std::runtime_error("unknown type \"" + type + "\"");
             }
-            out.push_back(ev);
+            out.events.push_back(ev);
         } catch (const nlohmann::json::exception& x) {
             throw std::runtime_error(where + x.what());
         } catch (const std::runtime_error& x) {

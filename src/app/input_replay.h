@@ -12,7 +12,9 @@
 //       { "frame": 9, "type": "drop",    "path": "shape.vdb" } ] }   (a file dropped on it)
 //
 // Coordinates are window pixels (origin top left); frames count from 0; events of one
-// frame are delivered in file order before that frame is drawn.
+// frame are delivered in file order before that frame is drawn. A file may name the window
+// its coordinates belong to, next to the events: "window": [640, 480] (width, height; 64 to
+// 8192 each, as --size takes them).
 #pragma once
 
 #include <string>
@@ -31,8 +33,13 @@ struct InputEvent {
     std::string path; // Drop
 };
 
+struct InputReplay {
+    std::vector<InputEvent> events;
+    int width = 0, height = 0; // the window the coordinates belong to; 0 when not named
+};
+
 // Reads and checks a replay file; throws std::runtime_error naming the file, the event
 // and the problem.
-std::vector<InputEvent> readInputEvents(const std::string& path);
+InputReplay readInputReplay(const std::string& path);
 
 } // namespace sweepers

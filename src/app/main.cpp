@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
 
+#include "app/input_replay.h"
 #include "app/modeler.h"
 #include "core/memory.h"
 #include "io/stroke_script.h"
@@ -20,7 +21,9 @@ static int run(int argc, char** argv) {
     app.add_option("--script", script, "a stroke script to open (same as giving it as file)");
     app.add_option("--voxel-size", o.voxelSize, "voxel size of a new sphere")
         ->check(CLI::PositiveNumber);
-    app.add_option("--size", size, "window size WIDTHxHEIGHT (default 1280x800)");
+    app.add_option("--size", size,
+                   "window size WIDTHxHEIGHT (default 1280x800, or the window a replay file "
+                   "names)");
     app.add_option("--screenshot", o.screenshot, "render one frame to this PNG and exit");
     app.add_option("--replay-input", o.replayInput,
                    "replay recorded mouse and keyboard events (JSON), then exit");
@@ -73,6 +76,20 @@ static int run(int argc, char** argv) {
                     "--size wants WIDTHxHEIGHT between 64 and 8192, like 800x600");
             o.width = w;
             o.height = h;
+        }
+        if (!o.replayInput.empty()) {
+            // Read before the window opens: its clicks belong to the window it names.
+            o.replay = sweepers::readInputReplay(o.replayInput);
+            const int w = o.replay.width, h = o.replay.height;
+            if (w > 0 && size.empty()) {
+                o.width = w;
+                o.height = h;
+            } else if (w > 0 && (w != o.width || h != o.height)) {
+                std::fprintf(stderr,
+                             "sweepers: %s was recorded in a %dx%d window; in this %dx%d one "
+                             "its clicks land elsewhere\n",
+                             o.replayInput.c_str(), w, h, o.width, o.height);
+            }
         }
         std::unique_ptr<tbb::global_control> limit;
         if (threads > 0)

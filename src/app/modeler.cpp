@@ -99,8 +99,7 @@ class Modeler {
 
     int run() {
         // Replayed events count frames in which no long job runs, as a user waits for one.
-        ReplayClock replay(opt_.replayInput.empty() ? std::vector<InputEvent>{}
-                                                    : readInputEvents(opt_.replayInput));
+        ReplayClock replay(opt_.replay.events);
         while (!glfwWindowShouldClose(win_)) {
             const auto t0 = Clock::now();
             glfwPollEvents();
@@ -492,14 +491,20 @@ class Modeler {
 
     void reportLatency() const {
         static const char* names[] = {"advect", "renorm", "mesh", "upload", "draw", "total"};
-        std::fprintf(stderr, "latency over %zu segments at voxel size %g (ms, p50 / p95):",
-                     latencies_.size(), doc_->grid().voxelSize()[0]);
-        for (int k = 0; k < 6; ++k) {
-            std::vector<double> v;
-            for (const auto& l : latencies_)
-                v.push_back(l[k]);
-            std::fprintf(stderr, " %s %.1f / %.1f%s", names[k], percentile(v, 0.5),
-                         percentile(v, 0.95), k < 5 ? "," : "\n");
+        if (latencies_.empty()) {
+            // Zeros would read as a measurement.
+            std::fprintf(stderr, "latency: nothing was sculpted, so there is nothing to report "
+                                 "(did the drags reach the shape?)\n");
+        } else {
+            std::fprintf(stderr, "latency over %zu segments at voxel size %g (ms, p50 / p95):",
+                         latencies_.size(), doc_->grid().voxelSize()[0]);
+            for (int k = 0; k < 6; ++k) {
+                std::vector<double> v;
+                for (const auto& l : latencies_)
+                    v.push_back(l[k]);
+                std::fprintf(stderr, " %s %.1f / %.1f%s", names[k], percentile(v, 0.5),
+                             percentile(v, 0.95), k < 5 ? "," : "\n");
+            }
         }
         if (!idleFrames_.empty())
             std::fprintf(stderr, "frame time when not sculpting (ms, p50 over %zu frames): %.1f\n",

@@ -4,6 +4,8 @@
 #include <cstddef>
 #include <string>
 
+#include "app/input_replay.h"
+
 namespace sweepers {
 
 struct ModelerOptions {
@@ -12,6 +14,7 @@ struct ModelerOptions {
     int width = 1280, height = 800;
     std::string screenshot;  // render, write this PNG and exit (after the replay, if any)
     std::string replayInput; // events to replay; the window closes after the last one
+    InputReplay replay;      // ... as read from that file
     bool replayLive = false; // replay at frame pace, not waiting for the sculpting
     std::string saveVdb;     // written when the window closes (for tests and batch use)
     std::string saveScript;  // the recorded stroke script, written when the window closes

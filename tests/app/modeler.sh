@@ -19,9 +19,11 @@ run --hide-ui --screenshot "$tmp/default.png" --replay-input "$tmp/none.json" --
 run --hide-ui --script "$here/dent.json" --screenshot "$tmp/dent.png"
 "$py" "$here/check_image.py" changed "$tmp/default.png" "$tmp/dent.png"
 
-# --- a replayed drag pulls the surface out; the recorded script replays to the same grid
-run --replay-input "$here/drag_a.json" --save "$tmp/a.vdb" --save-script "$tmp/a.json" \
-    --screenshot "$tmp/a.png" --latency-report --latency-csv "$tmp/latency.csv" 2>"$tmp/latency"
+# --- a replayed drag pulls the surface out; the recorded script replays to the same grid.
+#     No --size: the window is the one the file names, where its clicks reach the sphere.
+ASAN_OPTIONS=$app_asan "$app" --voxel-size 0.03125 --replay-input "$here/drag_a.json" \
+    --save "$tmp/a.vdb" --save-script "$tmp/a.json" --screenshot "$tmp/a.png" \
+    --latency-report --latency-csv "$tmp/latency.csv" 2>"$tmp/latency"
 cat "$tmp/latency"
 "$py" - "$tmp/latency" "$tmp/latency.csv" <<'PY'
 import csv, re, sys
@@ -50,6 +52,17 @@ assert after["mesh_triangles"] != before["mesh_triangles"]
 PY
 "$cli" apply "$tmp/a.json" -o "$tmp/a_replayed.vdb" -q
 "$py" "$here/same_grid.py" "$tmp/a.vdb" "$tmp/a_replayed.vdb"
+
+# --- a window other than the one a replay names: said; a report with nothing sculpted says
+#     so instead of printing zeros
+echo '{"window": [640, 480], "events": []}' >"$tmp/named.json"
+ASAN_OPTIONS=$app_asan "$app" --size 800x600 --voxel-size 0.03125 --hide-ui \
+    --replay-input "$tmp/named.json" --latency-report 2>"$tmp/named.err"
+grep -q "was recorded in a 640x480 window; in this 800x600 one" "$tmp/named.err" ||
+  { cat "$tmp/named.err"; fail "no word of the replay's other window"; }
+grep -q "^latency: nothing was sculpted" "$tmp/named.err" ||
+  { cat "$tmp/named.err"; fail "a report of nothing sculpted"; }
+cat "$tmp/named.err"
 
 # --- the same drag at frame pace, sculpting off the render thread (events coalesced):
 #     whatever was applied is in the script, which replays to the same grid ---------------

@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
         controller.setViewport(std::atoi(argv[2]), std::atoi(argv[3]));
         controller.setDocument(&doc);
         controller.frameView();
-        replayEvents(controller, readInputEvents(argv[1]));
+        replayEvents(controller, readInputReplay(argv[1]).events);
         doc.endEdit();
         doc.saveScript(argv[5]);
     } catch (const std::exception& e) {

@@ -36,7 +36,7 @@ std::string refused(const std::string& text) {
     const std::string path = dir / "events.json";
     std::ofstream(path) << text;
     try {
-        readInputEvents(path);
+        readInputReplay(path);
     } catch (const std::runtime_error& e) {
         return e.what();
     }
@@ -54,7 +54,7 @@ TEST(InputReplay, ReadsEventsAndRefusesBadOnesWithTheirPlace) {
         {"frame": 4, "type": "drop", "path": "a.vdb"},
         {"frame": 5, "type": "key", "key": "."},
         {"frame": 5, "type": "key", "key": "home"}]})";
-    const auto ev = readInputEvents(path);
+    const auto ev = readInputReplay(path).events;
     ASSERT_EQ(ev.size(), 6u);
     EXPECT_EQ(ev[4].key, GLFW_KEY_PERIOD);
     EXPECT_EQ(ev[5].key, GLFW_KEY_HOME);
@@ -77,4 +77,27 @@ TEST(InputReplay, ReadsEventsAndRefusesBadOnesWithTheirPlace) {
     EXPECT_NE(refused(R"({"events": [{"frame": 1, "type": "key", "key": "hyper"}]})")
                   .find("/events/0: key must be one character or one of space"),
               std::string::npos);
+}
+
+// The window a file's clicks belong to: read when named, refused with its place when it is
+// not two pixel sizes within what --size takes; 0 by 0 when the file does not name one.
+TEST(InputReplay, ReadsTheWindowTheEventsBelongTo) {
+    const test::ScratchDir dir;
+    const std::string path = dir / "window.json";
+    std::ofstream(path) << R"({"window": [640, 480], "events": []})";
+    const InputReplay named = readInputReplay(path);
+    EXPECT_EQ(named.width, 640);
+    EXPECT_EQ(named.height, 480);
+    std::ofstream(path) << R"({"events": [{"frame": 1, "type": "move", "x": 1, "y": 1}]})";
+    const InputReplay unnamed = readInputReplay(path);
+    EXPECT_EQ(unnamed.width, 0);
+    EXPECT_EQ(unnamed.height, 0);
+    EXPECT_EQ(unnamed.events.size(), 1u);
+    for (const char* bad :
+         {R"({"window": [640], "events": []})", R"({"window": [640, 480.5], "events": []})",
+          R"({"window": [640, 63], "events": []})", R"({"window": [8193, 480], "events": []})",
+          R"({"window": "640x480", "events": []})", R"({"window": [640, -480], "events": []})"})
+        EXPECT_NE(refused(bad).find("/window: expected [width, height] in pixels"),
+                  std::string::npos)
+            << bad;
 }

@@ -122,9 +122,9 @@ TEST(SculptController, EveryReplayFileSculptsAndRecordsAScriptThatReplaysExactly
     std::size_t files = 0;
     for (const auto& entry : std::filesystem::directory_iterator(SWEEPERS_APP_TEST_DIR)) {
         if (entry.path().extension() != ".json") continue;
-        std::vector<InputEvent> events;
+        InputReplay replay;
         try {
-            events = readInputEvents(entry.path().string());
+            replay = readInputReplay(entry.path().string());
         } catch (const std::exception&) {
             continue; // a stroke script, not events
         }
@@ -132,11 +132,14 @@ TEST(SculptController, EveryReplayFileSculptsAndRecordsAScriptThatReplaysExactly
         const std::string name = entry.path().filename().string();
         Document doc(Document::sphereScript(1.0 / 32), ".");
         SculptController ctl(/*waitEachPiece=*/true);
-        ctl.setViewport(kWidth, kHeight);
+        // The window the file's clicks belong to (every one of them names it).
+        EXPECT_GT(replay.width, 0) << name << " names no window";
+        ctl.setViewport(replay.width > 0 ? replay.width : kWidth,
+                        replay.height > 0 ? replay.height : kHeight);
         ctl.setDocument(&doc);
         ctl.frameView();
         const GridPtr before = doc.grid().deepCopy();
-        replayEvents(ctl, events);
+        replayEvents(ctl, replay.events);
         doc.endEdit();
         EXPECT_EQ(ctl.takeMessage(), "") << name;
         ASSERT_FALSE(doc.script().strokes.empty()) << name;
