@@ -70,6 +70,12 @@ class StepDeformation {
 
     double forwardTolerance() const { return forwardTolerance_; }
 
+    // A bound on how far the whole inverse map spreads points apart, as advection measures it
+    // (the largest singular value of its Jacobian by central differences over a voxel of any
+    // size); +infinity when none is known. Where the bound asks for no wider band than the
+    // grid's, advection does not measure the stretch.
+    virtual double stretchBound() const { return std::numeric_limits<double>::infinity(); }
+
   protected:
     // Solves p = next(p) for the p that sub-step k maps back onto q, by fixed-point
     // iteration from q to `tolerance` (relative to 1 + |q|; forwardTolerance() when 0), in

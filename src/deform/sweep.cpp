@@ -104,6 +104,14 @@ SweepSegment::SweepSegment(const Sweep& sweep, std::size_t index, const SegmentO
                                 " sub-steps; split it into more placements");
     steps_ = options.forceSteps > 0 ? options.forceSteps
                                     : std::max(1, static_cast<int>(std::floor(bound)) + 1);
+    // One tool translated by t: inverse sub-step k is p - phi_k(p) t / s (5.18), whose
+    // displacement is |t| / s times the slope of phi_k, so B / s Lipschitz (B the bound above,
+    // |t| the velocity everywhere). The displacement of s of them composed is
+    // (1 + B / s)^s - 1 Lipschitz, and so is each column of its central differences: their
+    // matrix spreads points apart by at most 1 + sqrt(3) ((1 + B / s)^s - 1).
+    if (sources.size() == 1 && sources[0].log.kind() == MotionLog::Kind::Translation)
+        stretchBound_ =
+            1.0 + std::sqrt(3.0) * std::expm1(double(steps_) * std::log1p(bound / steps_));
 
     // Sub-step placements tau_k = (k/s (.) M) X_A (3.12); tau_s is X_B exactly.
     stepBoxes_.assign(steps_, Box());

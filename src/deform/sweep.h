@@ -13,6 +13,7 @@
 // 5.4.1 generalized to several tools).
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -66,6 +67,9 @@ class SweepSegment : public StepDeformation {
     // Also true where the box lies in the affected box but beyond every tool's coating.
     bool identityOn(const Box& box) const override;
 
+    // Known for one tool moved without turning or scaling (a drag); +infinity otherwise.
+    double stretchBound() const override { return stretchBound_; }
+
     // For one tool, the blend is its influence times its log (3.17 with c phi = phi): the
     // sub-steps apply that directly. Several tools take the blend of stepLog.
     Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const override;
@@ -92,6 +96,7 @@ class SweepSegment : public StepDeformation {
     std::vector<ToolPlan> tools_;
     std::vector<Box> stepBoxes_; // union of coatings at tau_{k+1}
     double stepBound_ = 0.0;
+    double stretchBound_ = std::numeric_limits<double>::infinity();
 };
 
 // The reflection matrix of a mirror plane through the origin.

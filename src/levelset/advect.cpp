@@ -519,7 +519,17 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     tbb::enumerable_thread_specific<openvdb::MaskTree::Ptr> marks(
         [] { return std::make_shared<openvdb::MaskTree>(); });
     const VoxelPlacement place(grid.transform());
-    // The stretch at every kStretchSampling-th interface voxel (1 where not measured).
+    // The voxels the renormalization seeds from lie within 1.5 voxels of the new surface
+    // (crossing ends and their central differences); their pre-images lie within
+    // 1.5 * stretch voxels of the old one, and trilinear sampling reads one voxel beyond.
+    // Make sure the old band reaches that far, so none of them reads a clamped value.
+    const auto neededFor = [](double stretch) {
+        return std::ceil(1.5 * std::min(stretch, 32.0) + 1.0);
+    };
+    // The stretch at every kStretchSampling-th interface voxel (1 where not measured), unless
+    // the deformation's bound shows that the band is wide enough wherever it is measured
+    // (the drag's segments: 43,000 inverse maps and eigenvalue solves a segment at 1/128).
+    const bool measureStretch = neededFor(seg.stretchBound()) > halfWidth;
     std::vector<double> stretchAt(interface.size() / kStretchSampling + 1, 1.0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
         pollInterrupt(options.interrupter);
@@ -532,7 +542,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                 if (options.resampleEachSubStep || k + 1 == seg.steps())
                     m.setValueOn(openvdb::Coord::round(place.toIndex(toVdb(p))));
             }
-            if (i % kStretchSampling != 0) continue;
+            if (!measureStretch || i % kStretchSampling != 0) continue;
             // How far the inverse map can spread a voxel-sized neighbourhood of the new
             // surface: the largest singular value of its Jacobian.
             Eigen::Matrix3d J;
@@ -572,13 +582,8 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // the middle of the opening, so the inside voxels there join the band to be sampled
     // (renormalization drops them again, with their new sign).
     if (seg.tears()) stats.tornVoxels = markOpened(grid, seg, (halfWidth + 2) * h, *mask);
-    // The voxels the renormalization seeds from lie within 1.5 voxels of the new surface
-    // (crossing ends and their central differences); their pre-images lie within
-    // 1.5 * stretch voxels of the old one, and trilinear sampling reads one voxel beyond.
-    // Make sure the old band reaches that far, so none of them reads a clamped value.
-    const auto neededFor = [](double stretch) {
-        return std::ceil(1.5 * std::min(stretch, 32.0) + 1.0);
-    };
+    if (measureStretch)
+        stats.stretchSamples = (interface.size() + kStretchSampling - 1) / kStretchSampling;
     const double needed = neededFor(*std::max_element(stretchAt.begin(), stretchAt.end()));
     stats.widenedTo = std::max(halfWidth, needed);
     GridPtr widened; // the copies with the widened band, when it had to be widened

@@ -13,8 +13,9 @@
 // could send the pre-image of a voxel next to the new surface outside the old band, where
 // the old grid only holds +-background: the source band is then widened first (by fast
 // marching, inside the affected box) to cover the stretch of the inverse map, measured on
-// the forward-mapped interface, around the leaves where it was measured. After sampling,
-// inactive signs are re-derived by flood fill and the box is renormalized.
+// the forward-mapped interface (unless the deformation's own bound on it asks for nothing),
+// around the leaves where it was measured. After sampling, inactive signs are re-derived by
+// flood fill and the box is renormalized.
 #pragma once
 
 #include "deform/step_deformation.h"
@@ -38,8 +39,9 @@ struct AdvectStats {
     int subSteps = 0;
     std::size_t interfaceVoxels = 0; // forward-mapped to grow the band
     std::size_t sampledVoxels = 0;
-    double widenedTo = 0.0; // band half-width used for sampling, in voxels
-    int sampledReach = 0;   // how far around the images of the surface the band was sampled
+    double widenedTo = 0.0;         // band half-width used for sampling, in voxels
+    int sampledReach = 0;           // how far around the images of the surface the band was sampled
+    std::size_t stretchSamples = 0; // interface voxels where the stretch was measured
     // The work, counted: what a segment reads and writes follows the brush, never the
     // size of the model (the same stroke counts the same on a grid holding more shapes).
     std::size_t voxelsVisited = 0; // scanned for the interface, sampled, marched over

@@ -433,3 +433,47 @@ TEST(Advect, InterfaceVoxelsFoundByWordsAreThoseNextToTheCrossing) {
     EXPECT_GT(voxels, 4 * crossing);
     EXPECT_EQ(differ, 0u);
 }
+
+namespace {
+// A sweep segment that keeps its stretch bound to itself: advection measures the stretch.
+class WithoutStretchBound : public StepDeformation {
+  public:
+    explicit WithoutStretchBound(const SweepSegment& s) : s_(s) {
+        steps_ = s.steps();
+        affected_ = s.affectedBox();
+        forwardTolerance_ = s.forwardTolerance();
+    }
+    bool identityOn(const Box& box) const override { return s_.identityOn(box); }
+    bool stillAt(const Eigen::Vector3d& p) const override { return s_.stillAt(p); }
+    Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const override {
+        return s_.inverseStep(k, p);
+    }
+    ForwardResult forwardStep(int k, const Eigen::Vector3d& q, double tolerance) const override {
+        return s_.forwardStep(k, q, tolerance);
+    }
+
+  private:
+    const SweepSegment& s_;
+};
+} // namespace
+
+// A drag's segments bound their stretch well below what would widen the band, so it is not
+// measured; the grid is the one measuring it gives.
+TEST(Advect, ADragMeasuresNoStretchAndSculptsTheSame) {
+    const double h = 1.0 / 64;
+    const GridPtr bounded = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+    const GridPtr measured = bounded->deepCopy();
+    std::vector<Placement> path(4);
+    for (std::size_t k = 0; k < path.size(); ++k)
+        path[k].t = Eigen::Vector3d(0.012 * double(k), 0.008 * double(k), 1.0);
+    const Sweep drag{{{std::make_shared<EllipsoidShape>(0.25), 0.25, path}}};
+    for (std::size_t k = 0; k < drag.segmentCount(); ++k) {
+        const SweepSegment seg(drag, k);
+        const AdvectStats a = advectSegment(*bounded, seg);
+        const AdvectStats b = advectSegment(*measured, WithoutStretchBound(seg));
+        EXPECT_EQ(a.stretchSamples, 0u) << "segment " << k;
+        EXPECT_GT(b.stretchSamples, 100u) << "segment " << k;
+        EXPECT_EQ(a.widenedTo, b.widenedTo) << "segment " << k;
+    }
+    EXPECT_EQ(sweepers::test::differingVoxels(*bounded, *measured), 0u);
+}
