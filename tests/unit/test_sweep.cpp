@@ -327,7 +327,7 @@ TEST(Sweep, IdentityOnlyWhereNoToolReaches) {
 // tools give no bound.
 TEST(Sweep, ATranslatedToolBoundsTheStretch) {
     Rng rng(41);
-    double closest = 0.0; // the largest measured stretch over its bound
+    double closest = 0.0; // the largest measured excess over 1, as a part of the bound's
     for (int trial = 0; trial < 40; ++trial) {
         const double radius = rng.uniform(0.1, 0.4), falloff = rng.uniform(0.05, 0.4);
         // Moves from a hundredth of the falloff to twice it: one sub-step to several.
@@ -349,11 +349,11 @@ TEST(Sweep, ATranslatedToolBoundsTheStretch) {
             }
             const double stretch = J.jacobiSvd().singularValues()[0];
             ASSERT_LE(stretch, bound) << "trial " << trial << ", " << seg.steps() << " sub-steps";
-            closest = std::max(closest, stretch / bound);
+            closest = std::max(closest, (stretch - 1.0) / (bound - 1.0));
         }
     }
-    std::printf("[ sweep ] measured stretch at most %.3f of its bound\n", closest);
-    EXPECT_GT(closest, 0.9); // the bound is near what is measured, not vacuous
+    std::printf("[ sweep ] measured stretch beyond 1 at most %.3f of its bound's\n", closest);
+    EXPECT_GT(closest, 0.3); // the bound is near what is measured, not vacuous
     for (const Case& c : cases())
         if (std::string(c.name) != "translation")
             EXPECT_TRUE(std::isinf(SweepSegment(c.sweep, 0).stretchBound())) << c.name;
