@@ -48,12 +48,13 @@ InputReplay readInputReplay(const std::string& path) {
     if (doc.contains("window")) {
         const auto& w = doc["window"];
         const auto pixels = [](const nlohmann::json& v) {
-            return v.is_number_integer() && v.get<std::int64_t>() >= 64 &&
-                   v.get<std::int64_t>() <= 8192;
+            return v.is_number_integer() && v.get<std::int64_t>() >= kSmallestWindow &&
+                   v.get<std::int64_t>() <= kLargestWindow;
         };
         if (!w.is_array() || w.size() != 2 || !pixels(w[0]) || !pixels(w[1]))
-            throw std::runtime_error(path + ": /window: expected [width, height] in pixels, "
-                                            "64 to 8192 each, like [640, 480]");
+            throw std::runtime_error(path + ": /window: expected [width, height] in pixels, " +
+                                     std::to_string(kSmallestWindow) + " to " +
+                                     std::to_string(kLargestWindow) + " each, like [640, 480]");
         out.width = w[0].get<int>();
         out.height = w[1].get<int>();
     }

@@ -13,8 +13,8 @@
 //
 // Coordinates are window pixels (origin top left); frames count from 0; events of one
 // frame are delivered in file order before that frame is drawn. A file may name the window
-// its coordinates belong to, next to the events: "window": [640, 480] (width, height; 64 to
-// 8192 each, as --size takes them).
+// its coordinates belong to, next to the events: "window": [640, 480] (width, height; each
+// within kSmallestWindow and kLargestWindow, as --size takes them).
 #pragma once
 
 #include <string>
@@ -32,6 +32,9 @@ struct InputEvent {
     bool ctrl = false, shift = false;
     std::string path; // Drop
 };
+
+// The window sizes the modeler opens (--size) and a replay file may name, in pixels a side.
+constexpr int kSmallestWindow = 64, kLargestWindow = 8192;
 
 struct InputReplay {
     std::vector<InputEvent> events;

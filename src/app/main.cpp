@@ -1,6 +1,8 @@
 // sweepers: the interactive modeler.
+#include <algorithm>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
 
 #include <CLI/CLI.hpp>
 #include <tbb/global_control.h>
@@ -70,10 +72,12 @@ static int run(int argc, char** argv) {
         if (!size.empty()) {
             int w = 0, h = 0;
             char x = 0, extra = 0;
+            using sweepers::kLargestWindow, sweepers::kSmallestWindow;
             if (std::sscanf(size.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || x != 'x' ||
-                w < 64 || h < 64 || w > 8192 || h > 8192)
-                throw std::runtime_error(
-                    "--size wants WIDTHxHEIGHT between 64 and 8192, like 800x600");
+                std::min(w, h) < kSmallestWindow || std::max(w, h) > kLargestWindow)
+                throw std::runtime_error("--size wants WIDTHxHEIGHT between " +
+                                         std::to_string(kSmallestWindow) + " and " +
+                                         std::to_string(kLargestWindow) + ", like 800x600");
             o.width = w;
             o.height = h;
         }

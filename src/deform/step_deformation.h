@@ -72,7 +72,8 @@ class StepDeformation {
 
     // A bound on how far the whole inverse map spreads points apart, as advection measures it
     // (the largest singular value of its Jacobian by central differences over a voxel of any
-    // size); +infinity when none is known. Where the bound asks for no wider band than the
+    // size), which also holds for its first sub-steps alone (StepPrefix); +infinity when none
+    // is known. Where the bound asks for no wider band than the
     // grid's, advection does not measure the stretch.
     virtual double stretchBound() const { return std::numeric_limits<double>::infinity(); }
 

@@ -33,6 +33,8 @@ class StepPrefix : public StepDeformation {
                               double tolerance = 0.0) const override {
         return whole_.forwardStep(k, q, tolerance);
     }
+    // The whole's bound holds for its first sub-steps (StepDeformation::stretchBound).
+    double stretchBound() const override { return whole_.stretchBound(); }
 
   private:
     const StepDeformation& whole_;
