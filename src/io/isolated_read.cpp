@@ -7,7 +7,6 @@
 #include <cstring>
 #include <fstream>
 #include <new>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -18,6 +17,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <boost/iostreams/device/array.hpp>
 #include <boost/iostreams/device/file_descriptor.hpp>
 #include <boost/iostreams/stream.hpp>
 #include <openvdb/io/Stream.h>
@@ -250,7 +250,8 @@ ChildRead readInChild(const char* kind, const std::string& path, const std::stri
         throw FileError(path + ": the file is damaged: the VDB reader failed on it (exit code " +
                         std::to_string(code) + ")");
     try {
-        std::istringstream in(grid);
+        // Read where it lies (an istringstream would copy it first).
+        boost::iostreams::stream<boost::iostreams::array_source> in(grid.data(), grid.size());
         openvdb::io::Stream stream(in, /*delayLoad=*/false);
         const openvdb::GridPtrVecPtr grids = stream.getGrids();
         std::vector<std::string> fields;
