@@ -102,12 +102,13 @@ class Modeler {
         ReplayClock replay(opt_.replay.events);
         while (!glfwWindowShouldClose(win_)) {
             const auto t0 = Clock::now();
+            uploadedBricks_ = 0; // this frame's
             glfwPollEvents();
             syncViewport();
             pollJob();
             if (!job_) {
                 replay.deliver(ctl_, [this](const InputEvent& e) { dispatch(e); });
-                ctl_.step();
+                ctl_.step([this] { takeMesh(); });
                 takeFinished();
             }
             stepFilm();
@@ -130,10 +131,11 @@ class Modeler {
                 glFinish();
                 const auto now = Clock::now();
                 const SegmentReport& r = finished_.report;
-                latencies_.push_back({1e3 * (r.stats.growSeconds + r.stats.sampleSeconds),
-                                      1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds,
-                                      uploadMs_, 1e3 * secondsSince(drawStart, now),
-                                      1e3 * secondsSince(finished_.since, now)});
+                latencies_.push_back(
+                    {1e3 * (r.stats.growSeconds + r.stats.sampleSeconds),
+                     1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds,
+                     uploadedBricks_ ? uploadMs_ : 0.0, 1e3 * secondsSince(drawStart, now),
+                     1e3 * secondsSince(finished_.since, now), double(uploadedBricks_)});
                 measuring_ = false;
             }
             frameMs_ = 1e3 * secondsSince(t0);
@@ -480,6 +482,19 @@ class Modeler {
     }
 
     // Takes what the controller finished: a report to measure, or a message to show.
+    // The document's new mesh to the GPU, and the panel's figures (only while no sculpting
+    // works on the document). The film shows its own mesh; closing it uploads the document's.
+    void takeMesh() {
+        if (!doc_ || film_) return;
+        const auto t0 = Clock::now();
+        renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
+        uploadMs_ = 1e3 * secondsSince(t0);
+        uploadedBricks_ = renderer_->uploadedBricksLastUpdate();
+        groundY_ = activeWorldBox(doc_->grid()).min.y();
+        info_ = {doc_->grid().voxelSize()[0], std::size_t(doc_->grid().activeVoxelCount()),
+                 doc_->mesher().triangleCount(), doc_->undoCount(), doc_->undoBytes()};
+    }
+
     void takeFinished() {
         if (auto f = ctl_.takeFinished()) {
             finished_ = *f;
@@ -512,11 +527,11 @@ class Modeler {
     }
 
     void writeLatencyCsv(const std::string& path) const {
-        std::string text = "advect,renorm,mesh,upload,draw,total\n";
+        std::string text = "advect,renorm,mesh,upload,draw,total,bricks\n";
         char row[256];
         for (const auto& l : latencies_) {
-            std::snprintf(row, sizeof row, "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f\n", l[0], l[1], l[2],
-                          l[3], l[4], l[5]);
+            std::snprintf(row, sizeof row, "%.4f,%.4f,%.4f,%.4f,%.4f,%.4f,%.0f\n", l[0], l[1], l[2],
+                          l[3], l[4], l[5], l[6]);
             text += row;
         }
         writeTextAtomically(path, text);
@@ -546,13 +561,6 @@ class Modeler {
                 renderer_->update(*m, film_->takeMeshChanges());
                 uploadMs_ = 1e3 * secondsSince(t0);
             }
-        } else if (!ctl_.busy()) {
-            const auto t0 = Clock::now();
-            renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
-            uploadMs_ = 1e3 * secondsSince(t0);
-            groundY_ = activeWorldBox(doc_->grid()).min.y();
-            info_ = {doc_->grid().voxelSize()[0], std::size_t(doc_->grid().activeVoxelCount()),
-                     doc_->mesher().triangleCount(), doc_->undoCount(), doc_->undoBytes()};
         }
         const ToolSettings& s = ctl_.settings();
         ToolOverlay tool;
@@ -837,10 +845,12 @@ class Modeler {
     bool askQuit_ = false, discard_ = false;
     SculptController::Finished finished_;
     bool measuring_ = false;
-    // Per segment: advect, renorm, mesh, upload, draw (+ swap, finish), total; in ms.
-    std::vector<std::array<double, 6>> latencies_;
+    // Per piece: advect, renorm, mesh, upload, draw (+ swap, finish) and total, in ms, and
+    // how many mesh bricks its frame uploaded.
+    std::vector<std::array<double, 7>> latencies_;
     std::vector<double> idleFrames_;
     double frameMs_ = 0, uploadMs_ = 0;
+    std::size_t uploadedBricks_ = 0;
     char path_[1024] = {};
     std::string error_, status_;
 };

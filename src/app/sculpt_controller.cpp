@@ -425,9 +425,11 @@ void SculptController::finishDrag() {
 
 // One piece of sculpting for the latest cursor position of a drag: a sweep segment (or a
 // few, for a fast twist), a swirl ring, a fluid push or a dab of clay.
-void SculptController::step() {
+void SculptController::step(const std::function<void()>& idle) {
     collect();
-    if (busy() || drag_ != DragKind::Sculpt) return;
+    if (busy()) return;
+    if (idle) idle();
+    if (drag_ != DragKind::Sculpt) return;
     if (topologyMode()) {
         stepTopologyDrag();
         return;

@@ -95,8 +95,11 @@ class SculptController {
     // A replayed event (all but drops, which open files: the window's job).
     void dispatch(const InputEvent& e);
 
-    // Once per frame: takes finished work and starts the next piece of a drag.
-    void step();
+    // Once per frame: takes finished work and starts the next piece of a drag. In between,
+    // when no work runs, `idle` may read the document (the window takes the mesh of the
+    // piece just finished: during a drag the next piece starts at once, and the mesher is
+    // the worker's again until it ends).
+    void step(const std::function<void()>& idle = {});
     // Replays take the next frame's events only when this is true (see waitEachPiece).
     bool readyForEvents() const { return !busy() || !waitEach_; }
     bool busy() const { return work_.valid(); }

@@ -185,6 +185,38 @@ TEST(SculptController, EscapeCancelsTheDragAndPutsTheShapeBack) {
     EXPECT_EQ(s.doc.script().strokes.size(), 1u);
 }
 
+// A hand that keeps moving: each piece of the drag starts as soon as the one before ends,
+// and in between (step's idle) the window takes the mesh of the piece that ended, so every
+// piece is seen on screen, not only the last one after the hand stops.
+TEST(SculptController, BetweenPiecesOfADragTheWindowTakesEachPiecesMesh) {
+    Document doc{Document::sphereScript(1.0 / 32), "."};
+    SculptController ctl; // pieces run while events come in, as in the window
+    ctl.setViewport(kWidth, kHeight);
+    ctl.setDocument(&doc);
+    ctl.frameView();
+    doc.takeMeshChanges(); // the sphere's
+    int meshesTaken = 0;
+    const auto idle = [&] { meshesTaken += doc.takeMeshChanges().any(); };
+    constexpr int kPieces = 5;
+    ctl.onKey('G', false, false);
+    ctl.onButton(0, true, kWidth / 2.0, kHeight / 2.0, false);
+    ASSERT_EQ(ctl.drag(), DragKind::Sculpt) << "the press missed the sphere";
+    for (int k = 1; k <= kPieces; ++k) {
+        ctl.onMove(kWidth / 2.0 + 10.0 * k, kHeight / 2.0);
+        ctl.step(idle); // takes the piece before, and starts this one
+        ASSERT_TRUE(ctl.busy());
+        EXPECT_EQ(meshesTaken, k - 1);
+        ctl.wait();
+    }
+    ctl.onButton(0, false, kWidth / 2.0 + 10.0 * kPieces, kHeight / 2.0, false);
+    ctl.step(idle);
+    EXPECT_EQ(ctl.drag(), DragKind::None);
+    EXPECT_EQ(meshesTaken, kPieces);
+    ASSERT_EQ(doc.script().strokes.size(), 1u);
+    EXPECT_EQ(std::get<SweepStroke>(doc.script().strokes[0]).tools[0].path.size(),
+              std::size_t(kPieces + 1));
+}
+
 TEST(Cancel, EveryLongOperationStopsAndLeavesItsInputAsItWas) {
     const GridPtr sphere = makeSphere({0, 0, 0}, 1.0, 1.0 / 48, 3.0);
     // Renormalization: nothing written back.
