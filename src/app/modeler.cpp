@@ -481,7 +481,6 @@ class Modeler {
             ctl_.dispatch(e);
     }
 
-    // Takes what the controller finished: a report to measure, or a message to show.
     // The document's new mesh to the GPU, and the panel's figures (only while no sculpting
     // works on the document). The film shows its own mesh; closing it uploads the document's.
     void takeMesh() {
@@ -495,6 +494,7 @@ class Modeler {
                  doc_->mesher().triangleCount(), doc_->undoCount(), doc_->undoBytes()};
     }
 
+    // Takes what the controller finished: a report to measure, or a message to show.
     void takeFinished() {
         if (auto f = ctl_.takeFinished()) {
             finished_ = *f;
