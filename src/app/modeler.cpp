@@ -50,6 +50,7 @@ class Modeler {
         : batch_(!o.replayInput.empty() || !o.screenshot.empty() || !o.recordFrames.empty()),
           ctl_(batch_ && !o.replayLive), opt_(o), win_(w) {
         renderer_ = std::make_unique<GlRenderer>(findShaderDir(o.argv0));
+        ctl_.setIdle([this] { takeMesh(); });
         std::snprintf(path_, sizeof path_, "%s", o.open.empty() ? "untitled.vdb" : o.open.c_str());
         voxelSizeInput_ = float(o.voxelSize);
         syncViewport();
@@ -102,13 +103,14 @@ class Modeler {
         ReplayClock replay(opt_.replay.events);
         while (!glfwWindowShouldClose(win_)) {
             const auto t0 = Clock::now();
-            uploadedBricks_ = 0; // this frame's
+            uploadMs_ = 0; // this frame's uploads (a release may take a piece as well as step)
+            uploadedBricks_ = 0;
             glfwPollEvents();
             syncViewport();
             pollJob();
             if (!job_) {
                 replay.deliver(ctl_, [this](const InputEvent& e) { dispatch(e); });
-                ctl_.step([this] { takeMesh(); });
+                ctl_.step();
                 takeFinished();
             }
             stepFilm();
@@ -131,11 +133,11 @@ class Modeler {
                 glFinish();
                 const auto now = Clock::now();
                 const SegmentReport& r = finished_.report;
-                latencies_.push_back(
-                    {1e3 * (r.stats.growSeconds + r.stats.sampleSeconds),
-                     1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds,
-                     uploadedBricks_ ? uploadMs_ : 0.0, 1e3 * secondsSince(drawStart, now),
-                     1e3 * secondsSince(finished_.since, now), double(uploadedBricks_)});
+                latencies_.push_back({1e3 * (r.stats.growSeconds + r.stats.sampleSeconds),
+                                      1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds,
+                                      uploadMs_, 1e3 * secondsSince(drawStart, now),
+                                      1e3 * secondsSince(finished_.since, now),
+                                      double(uploadedBricks_)});
                 measuring_ = false;
             }
             frameMs_ = 1e3 * secondsSince(t0);
@@ -487,8 +489,8 @@ class Modeler {
         if (!doc_ || film_) return;
         const auto t0 = Clock::now();
         renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
-        uploadMs_ = 1e3 * secondsSince(t0);
-        uploadedBricks_ = renderer_->uploadedBricksLastUpdate();
+        uploadMs_ += 1e3 * secondsSince(t0);
+        uploadedBricks_ += renderer_->uploadedBricksLastUpdate();
         groundY_ = activeWorldBox(doc_->grid()).min.y();
         info_ = {doc_->grid().voxelSize()[0], std::size_t(doc_->grid().activeVoxelCount()),
                  doc_->mesher().triangleCount(), doc_->undoCount(), doc_->undoBytes()};

@@ -425,10 +425,10 @@ void SculptController::finishDrag() {
 
 // One piece of sculpting for the latest cursor position of a drag: a sweep segment (or a
 // few, for a fast twist), a swirl ring, a fluid push or a dab of clay.
-void SculptController::step(const std::function<void()>& idle) {
+void SculptController::step() {
     collect();
     if (busy()) return;
-    if (idle) idle();
+    if (idle_) idle_();
     if (drag_ != DragKind::Sculpt) return;
     if (topologyMode()) {
         stepTopologyDrag();

@@ -95,11 +95,14 @@ class SculptController {
     // A replayed event (all but drops, which open files: the window's job).
     void dispatch(const InputEvent& e);
 
-    // Once per frame: takes finished work and starts the next piece of a drag. In between,
-    // when no work runs, `idle` may read the document (the window takes the mesh of the
-    // piece just finished: during a drag the next piece starts at once, and the mesher is
-    // the worker's again until it ends).
-    void step(const std::function<void()>& idle = {});
+    // Once per frame (and at a drag's release): takes finished work and starts the next
+    // piece of a drag.
+    void step();
+    // Called by step() between taking finished work and starting the next piece, when no
+    // work runs and the document may be read: the window takes the mesh of the piece just
+    // finished there (during a drag the next piece starts at once, and the mesher is the
+    // worker's again until it ends).
+    void setIdle(std::function<void()> idle) { idle_ = std::move(idle); }
     // Replays take the next frame's events only when this is true (see waitEachPiece).
     bool readyForEvents() const { return !busy() || !waitEach_; }
     bool busy() const { return work_.valid(); }
@@ -158,6 +161,7 @@ class SculptController {
 
     Document* doc_ = nullptr;
     bool waitEach_ = false, sculpting_ = true;
+    std::function<void()> idle_;
     int width_ = 1, height_ = 1;
     OrbitCamera camera_;
     ToolSettings settings_;

@@ -186,8 +186,9 @@ TEST(SculptController, EscapeCancelsTheDragAndPutsTheShapeBack) {
 }
 
 // A hand that keeps moving: each piece of the drag starts as soon as the one before ends,
-// and in between (step's idle) the window takes the mesh of the piece that ended, so every
-// piece is seen on screen, not only the last one after the hand stops.
+// and in between (the controller's idle call) the window takes the mesh of the piece that
+// ended, so every piece is seen on screen, not only the last one after the hand stops. A
+// release that starts the last piece takes the one before it the same way.
 TEST(SculptController, BetweenPiecesOfADragTheWindowTakesEachPiecesMesh) {
     Document doc{Document::sphereScript(1.0 / 32), "."};
     SculptController ctl; // pieces run while events come in, as in the window
@@ -196,25 +197,30 @@ TEST(SculptController, BetweenPiecesOfADragTheWindowTakesEachPiecesMesh) {
     ctl.frameView();
     doc.takeMeshChanges(); // the sphere's
     int meshesTaken = 0;
-    const auto idle = [&] { meshesTaken += doc.takeMeshChanges().any(); };
-    constexpr int kPieces = 5;
+    ctl.setIdle([&] { meshesTaken += doc.takeMeshChanges().any(); });
+    constexpr int kMoves = 5;
+    const double x0 = kWidth / 2.0, y0 = kHeight / 2.0;
     ctl.onKey('G', false, false);
-    ctl.onButton(0, true, kWidth / 2.0, kHeight / 2.0, false);
+    ctl.onButton(0, true, x0, y0, false);
     ASSERT_EQ(ctl.drag(), DragKind::Sculpt) << "the press missed the sphere";
-    for (int k = 1; k <= kPieces; ++k) {
-        ctl.onMove(kWidth / 2.0 + 10.0 * k, kHeight / 2.0);
-        ctl.step(idle); // takes the piece before, and starts this one
+    for (int k = 1; k <= kMoves; ++k) {
+        ctl.onMove(x0 + 10.0 * k, y0);
+        ctl.step(); // takes the piece before, and starts this one
         ASSERT_TRUE(ctl.busy());
         EXPECT_EQ(meshesTaken, k - 1);
         ctl.wait();
     }
-    ctl.onButton(0, false, kWidth / 2.0 + 10.0 * kPieces, kHeight / 2.0, false);
-    ctl.step(idle);
+    // Released farther on: one piece more, started by the release.
+    ctl.onButton(0, false, x0 + 10.0 * (kMoves + 1), y0, false);
+    ASSERT_TRUE(ctl.busy());
+    EXPECT_EQ(meshesTaken, kMoves);
+    ctl.wait();
+    ctl.step();
     EXPECT_EQ(ctl.drag(), DragKind::None);
-    EXPECT_EQ(meshesTaken, kPieces);
+    EXPECT_EQ(meshesTaken, kMoves + 1);
     ASSERT_EQ(doc.script().strokes.size(), 1u);
     EXPECT_EQ(std::get<SweepStroke>(doc.script().strokes[0]).tools[0].path.size(),
-              std::size_t(kPieces + 1));
+              std::size_t(kMoves + 2));
 }
 
 TEST(Cancel, EveryLongOperationStopsAndLeavesItsInputAsItWas) {
