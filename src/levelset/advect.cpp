@@ -16,7 +16,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <openvdb/tools/ChangeBackground.h>
-#include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/Morphology.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -41,6 +40,18 @@ float trilinearIn(const float (&c)[2][2][2], const openvdb::Vec3d& uvw) {
     const auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
     return lerp(lerp(lerp(c[0][0][0], c[0][0][1], w), lerp(c[0][1][0], c[0][1][1], w), v),
                 lerp(lerp(c[1][0][0], c[1][0][1], w), lerp(c[1][1][0], c[1][1][1], w), v), u);
+}
+
+// The cell (its lowest corner) holding index-space point p: the floor on each axis, as a
+// truncation and a compare. std::floor is a call into libm in the baseline x86-64 build (23
+// instructions more a sampled voxel of the drag); the integers are the same for any point
+// within a grid's coordinates.
+openvdb::Coord cellOf(const openvdb::Vec3d& p) {
+    const auto down = [](double x) {
+        const int i = int(x);
+        return i - int(x < double(i));
+    };
+    return openvdb::Coord(down(p[0]), down(p[1]), down(p[2]));
 }
 
 // What sampling reads: the grid as it was before sampling began. Sampling writes only the
@@ -96,9 +107,8 @@ class SampleSource {
         // When the cell lies inside one leaf (343 cells in 512) its eight corners are read
         // from that leaf's buffer, after a single lookup instead of eight.
         float trilinear(const openvdb::Vec3d& p) const {
-            const openvdb::Vec3i base = openvdb::tools::local_util::floorVec3(p);
-            const openvdb::Vec3d uvw = p - base;
-            const openvdb::Coord ijk(base);
+            const openvdb::Coord ijk = cellOf(p);
+            const openvdb::Vec3d uvw = p - ijk.asVec3d();
             float data[2][2][2];
             const LeafNode* leaf = nullptr;
             if ((ijk[0] & 7) < 7 && (ijk[1] & 7) < 7 && (ijk[2] & 7) < 7) {
@@ -241,7 +251,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                             const openvdb::Vec3d p = place.toIndex(toVdb(at));
                             if (sampling != Sampling::Trilinear)
                                 return float(sampleMonotoneCubic(acc, p));
-                            const openvdb::Coord cell(openvdb::tools::local_util::floorVec3(p));
+                            const openvdb::Coord cell = cellOf(p);
                             if (!filled) {
                                 block.fill(acc, leaf.origin());
                                 filled = true;
