@@ -42,6 +42,12 @@ namespace sweepers {
 
 namespace {
 
+// After input, an interactive window draws this many frames (ImGui lays a new window out in
+// one frame and draws it in the next), then waits for more input; it wakes this often to show
+// what other threads report.
+constexpr int kSettleFrames = 4;
+constexpr double kIdleWakeSeconds = 0.25;
+
 // The window, its drawing and panels, and long jobs (open, import, resample) off the
 // render thread. What input does to the document and the camera is the controller's.
 class Modeler {
@@ -105,7 +111,12 @@ class Modeler {
             const auto t0 = Clock::now();
             uploadMs_ = 0; // this frame's uploads (a release may take a piece as well as step)
             uploadedBricks_ = 0;
-            glfwPollEvents();
+            // With nothing to show, an interactive window waits for input instead of drawing
+            // the same picture again (a core of software GL, or the GPU at the display's rate).
+            if (framesToDraw_ > 0 || !idle())
+                glfwPollEvents();
+            else
+                glfwWaitEventsTimeout(kIdleWakeSeconds);
             syncViewport();
             pollJob();
             if (!job_) {
@@ -117,10 +128,21 @@ class Modeler {
             if (session_) {
                 const std::string problem = session_->takeError();
                 if (!problem.empty()) {
+                    wake();
                     status_ = problem;
                     std::fprintf(stderr, "sweepers: %s\n", problem.c_str());
                 }
             }
+            if (!batch_ && glfwWindowShouldClose(win_) && !ctl_.busy() && doc_->modified() &&
+                !discard_) {
+                glfwSetWindowShouldClose(win_, GLFW_FALSE); // ask first
+                askQuit_ = true;
+                wake();
+            }
+            if (woken_ || !idle()) framesToDraw_ = kSettleFrames;
+            woken_ = false;
+            if (framesToDraw_ == 0) continue; // the picture on screen is still right
+            --framesToDraw_;
             const auto drawStart = Clock::now();
             draw();
             if (batch_ && !job_ && !ctl_.busy() && ctl_.drag() == DragKind::None && replay.over() &&
@@ -143,11 +165,6 @@ class Modeler {
             frameMs_ = 1e3 * secondsSince(t0);
             if (ctl_.drag() == DragKind::None && !ctl_.busy() && !job_)
                 idleFrames_.push_back(frameMs_);
-            if (!batch_ && glfwWindowShouldClose(win_) && !ctl_.busy() && doc_->modified() &&
-                !discard_) {
-                glfwSetWindowShouldClose(win_, GLFW_FALSE); // ask first
-                askQuit_ = true;
-            }
         }
         ctl_.wait();
         ctl_.step();
@@ -164,6 +181,13 @@ class Modeler {
         // A clean end: the user saved or chose to discard (or a batch run wrote its files).
         if (session_) session_->close();
         return 0;
+    }
+
+    // Input or a change of the window (any of GLFW's callbacks): frames are drawn again.
+    void wake() { woken_ = true; }
+    // Nothing runs or moves that a frame would show: no replay, long job, sculpting or film.
+    bool idle() const {
+        return !batch_ && !job_ && !ctl_.busy() && ctl_.drag() == DragKind::None && !film_;
     }
 
     // --- input from GLFW's callbacks (ImGui keeps what falls on its panels) -------------
@@ -847,6 +871,8 @@ class Modeler {
     bool askQuit_ = false, discard_ = false;
     SculptController::Finished finished_;
     bool measuring_ = false;
+    bool woken_ = true;    // input since the last frame (and at the start)
+    int framesToDraw_ = 0; // before the window waits for input
     // Per piece: advect, renorm, mesh, upload, draw (+ swap, finish) and total, in ms, and
     // how many mesh bricks its frame uploaded.
     std::vector<std::array<double, 7>> latencies_;
@@ -871,7 +897,12 @@ bool imguiWantsMouse() {
 }
 
 // GLFW callbacks; ImGui's backend chains to them, and keeps what falls on its panels.
+// Any callback wakes the window (Modeler::wake), whatever ImGui keeps.
+void wakeCallback(GLFWwindow* w) {
+    if (Modeler* m = modelerOf(w)) m->wake();
+}
 void buttonCallback(GLFWwindow* w, int button, int action, int mods) {
+    wakeCallback(w);
     Modeler* m = modelerOf(w);
     if (!m || imguiWantsMouse()) return;
     double x, y;
@@ -880,18 +911,22 @@ void buttonCallback(GLFWwindow* w, int button, int action, int mods) {
     m->onButton(b, action == GLFW_PRESS, x, y, (mods & GLFW_MOD_SHIFT) != 0);
 }
 void cursorCallback(GLFWwindow* w, double x, double y) {
+    wakeCallback(w);
     if (Modeler* m = modelerOf(w)) m->onMove(x, y);
 }
 void scrollCallback(GLFWwindow* w, double, double dy) {
+    wakeCallback(w);
     Modeler* m = modelerOf(w);
     if (!m || imguiWantsMouse()) return;
     m->onScroll(dy, ctrlDown(w));
 }
 void dropCallback(GLFWwindow* w, int count, const char** paths) {
+    wakeCallback(w);
     Modeler* m = modelerOf(w);
     if (m && count > 0) m->openFile(paths[0]);
 }
 void keyCallback(GLFWwindow* w, int key, int, int action, int mods) {
+    wakeCallback(w);
     Modeler* m = modelerOf(w);
     if (!m || action == GLFW_RELEASE) return;
     // Esc always reaches the modeler: it cancels long work even over a panel.
@@ -959,6 +994,14 @@ int runModeler(const ModelerOptions& o) {
     glfwSetScrollCallback(w, scrollCallback);
     glfwSetKeyCallback(w, keyCallback);
     glfwSetDropCallback(w, dropCallback);
+    // What only ImGui or the window itself reads wakes the window too (ImGui chains to these).
+    glfwSetCharCallback(w, [](GLFWwindow* win, unsigned) { wakeCallback(win); });
+    glfwSetCursorEnterCallback(w, [](GLFWwindow* win, int) { wakeCallback(win); });
+    glfwSetWindowFocusCallback(w, [](GLFWwindow* win, int) { wakeCallback(win); });
+    glfwSetWindowRefreshCallback(w, wakeCallback);
+    glfwSetWindowCloseCallback(w, wakeCallback);
+    glfwSetFramebufferSizeCallback(w, [](GLFWwindow* win, int, int) { wakeCallback(win); });
+    glfwSetWindowIconifyCallback(w, [](GLFWwindow* win, int) { wakeCallback(win); });
     IMGUI_CHECKVERSION();
     ImGui::CreateContext();
     session.imgui = true;

@@ -15,6 +15,27 @@ version=$(run --version)
 run --hide-ui --screenshot "$tmp/default.png" --replay-input "$tmp/none.json" --save "$tmp/default.vdb"
 "$py" "$here/check_image.py" centred "$tmp/default.png"
 
+# --- an idle window draws nothing: with no input and nothing running it waits for input
+#     (redrawing the same picture kept one and a half cores busy under Mesa) -------------
+ASAN_OPTIONS=$app_asan "$app" --size 640x480 --voxel-size 0.03125 --session-dir "$tmp/idle" \
+    2>"$tmp/idle.err" &
+idle=$!
+ticks() {
+  kill -0 "$idle" 2>/dev/null || { cat "$tmp/idle.err"; fail "the idle window ended"; }
+  awk '{print $14 + $15}' "/proc/$idle/stat"
+}
+quiet=0 # once started, a second in which it used at most 5% of a core
+for _ in $(seq 30); do
+  before=$(ticks)
+  sleep 1
+  used=$(($(ticks) - before))
+  if [ "$used" -le $(($(getconf CLK_TCK) / 20)) ]; then quiet=1; break; fi
+done
+kill "$idle"
+wait "$idle" || true
+[ "$quiet" = 1 ] || fail "the idle window kept drawing: $used clock ticks in its last second"
+echo "idle window: $used clock ticks in a second"
+
 # --- a script that dents the side facing the camera: the picture changes there ----------
 run --hide-ui --script "$here/dent.json" --screenshot "$tmp/dent.png"
 "$py" "$here/check_image.py" changed "$tmp/default.png" "$tmp/dent.png"
