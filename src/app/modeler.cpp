@@ -511,13 +511,20 @@ class Modeler {
     // works on the document). The film shows its own mesh; closing it uploads the document's.
     void takeMesh() {
         if (!doc_ || film_) return;
-        const auto t0 = Clock::now();
-        renderer_->update(doc_->mesher(), doc_->takeMeshChanges());
-        uploadMs_ += 1e3 * secondsSince(t0);
-        uploadedBricks_ += renderer_->uploadedBricksLastUpdate();
-        groundY_ = activeWorldBox(doc_->grid()).min.y();
-        info_ = {doc_->grid().voxelSize()[0], std::size_t(doc_->grid().activeVoxelCount()),
-                 doc_->mesher().triangleCount(), doc_->undoCount(), doc_->undoBytes()};
+        const MeshChanges changes = doc_->takeMeshChanges();
+        if (changes.any()) {
+            const auto t0 = Clock::now();
+            renderer_->update(doc_->mesher(), changes);
+            uploadMs_ += 1e3 * secondsSince(t0);
+            uploadedBricks_ += renderer_->uploadedBricksLastUpdate();
+            groundY_ = activeWorldBox(doc_->grid()).min.y();
+        }
+        // Only a new mesh or a change of the undo history changes the figures (counting the
+        // active voxels walks the whole tree: not at every wake of an idle window).
+        if (changes.any() || doc_->undoCount() != info_.undoCount ||
+            doc_->undoBytes() != info_.undoBytes)
+            info_ = {doc_->grid().voxelSize()[0], std::size_t(doc_->grid().activeVoxelCount()),
+                     doc_->mesher().triangleCount(), doc_->undoCount(), doc_->undoBytes()};
     }
 
     // Takes what the controller finished: a report to measure, or a message to show.
