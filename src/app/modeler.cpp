@@ -113,7 +113,7 @@ class Modeler {
             uploadedBricks_ = 0;
             // With nothing to show, an interactive window waits for input instead of drawing
             // the same picture again (a core of software GL, or the GPU at the display's rate).
-            if (framesToDraw_ > 0 || !idle())
+            if (framesToDraw_ > 0 || !resting())
                 glfwPollEvents();
             else
                 glfwWaitEventsTimeout(kIdleWakeSeconds);
@@ -139,7 +139,7 @@ class Modeler {
                 askQuit_ = true;
                 wake();
             }
-            if (woken_ || !idle()) framesToDraw_ = kSettleFrames;
+            if (woken_ || !resting()) framesToDraw_ = kSettleFrames;
             woken_ = false;
             if (framesToDraw_ == 0) continue; // the picture on screen is still right
             --framesToDraw_;
@@ -186,7 +186,7 @@ class Modeler {
     // Input or a change of the window (any of GLFW's callbacks): frames are drawn again.
     void wake() { woken_ = true; }
     // Nothing runs or moves that a frame would show: no replay, long job, sculpting or film.
-    bool idle() const {
+    bool resting() const {
         return !batch_ && !job_ && !ctl_.busy() && ctl_.drag() == DragKind::None && !film_;
     }
 
