@@ -134,9 +134,15 @@ double upwindValue(const Grid::ConstAccessor& acc, const openvdb::Coord& ijk, do
 // the band's half-width. The engine solves them leaf by leaf in parallel, passing changes
 // across leaves until none is left: a leaf left unsolved, or a change not passed on, leaves
 // a voxel off its value.
-void solvesTheUpwindEquations(const char* name, GridPtr g) {
+// `region`: where the band was renormalized (the rest keeps its distorted values, which the
+// voxels at its edge read as they are); by default the whole band.
+void solvesTheUpwindEquations(const char* name, GridPtr g,
+                              const openvdb::CoordBBox& region = openvdb::CoordBBox::inf()) {
     distort(*g);
-    renormalizeAll(*g, FmmOrder::Second);
+    if (region == openvdb::CoordBBox::inf())
+        renormalizeAll(*g, FmmOrder::Second);
+    else
+        renormalize(*g, region, FmmOrder::Second);
     const double h = g->voxelSize()[0], bg = g->background();
     const auto acc = g->getConstAccessor();
     const auto across = [&](const openvdb::Coord& ijk) {
@@ -154,7 +160,7 @@ void solvesTheUpwindEquations(const char* name, GridPtr g) {
     for (auto leaf = g->tree().cbeginLeaf(); leaf; ++leaf)
         for (auto it = leaf->cbeginValueAll(); it; ++it) {
             const openvdb::Coord ijk = it.getCoord();
-            if (across(ijk)) continue; // a seed
+            if (!region.isInside(ijk) || across(ijk)) continue; // kept, or a seed
             const double u = upwindValue(acc, ijk, h);
             if (it.isValueOn()) {
                 worst = std::max(worst, std::abs(u - std::abs(double(*it))) / h);
@@ -184,6 +190,16 @@ TEST(FastMarching, SolvesTheUpwindEquationsAcrossLeaves) {
     auto torus = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
     solvesTheUpwindEquations(
         "torus", gridFromSdf(torus, h, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90)));
+}
+
+// Renormalizing part of the band, as a stroke segment does: the voxels solved hold their
+// upwind values, those at the edge of the part reading the kept (distorted) values beyond it.
+TEST(FastMarching, SolvesTheUpwindEquationsInAPartOfTheBand) {
+    const double h = 1.0 / 48;
+    auto torus = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
+    solvesTheUpwindEquations(
+        "part", gridFromSdf(torus, h, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90)),
+        openvdb::CoordBBox({-13, -40, -20}, {40, 11, 20}));
 }
 
 TEST(FastMarching, RenormalizesADistortedSphere) {
