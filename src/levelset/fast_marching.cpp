@@ -563,12 +563,14 @@ class Renormalizer {
     // value. (With a bit test and two selects a voxel, filling blocks took 207M of the 1141M
     // instructions renormalizing the drag's first ten segments at 1/128; now 123M.)
     template <int RowAxis> void loadAs(std::size_t l, int rim, Block& block) const {
-        constexpr int R = Block::kRim;
+        using Index = std::ptrdiff_t; // offsets into the block and the leaves
+        constexpr Index R = Block::kRim;
         // The leaf axes along the block's axes, and their strides in a leaf (Block::setRowAxis).
         constexpr int kAxes[3] = {RowAxis == 0 ? 2 : 0, RowAxis == 1 ? 2 : 1, RowAxis};
-        constexpr int kLeafStride[3] = {1 << (6 - 3 * kAxes[0]), 1 << (6 - 3 * kAxes[1]),
-                                        1 << (6 - 3 * kAxes[2])};
-        constexpr int S0 = Block::kStride[0], S1 = Block::kStride[1];
+        constexpr Index kLeafStride[3] = {Index(1) << (6 - 3 * kAxes[0]),
+                                          Index(1) << (6 - 3 * kAxes[1]),
+                                          Index(1) << (6 - 3 * kAxes[2])};
+        constexpr Index S0 = Block::kStride[0], S1 = Block::kStride[1];
         float* in = block.side[1].data();
         float* out = block.side[0].data();
         using F = float __attribute__((vector_size(16)));
@@ -576,7 +578,7 @@ class Renormalizer {
         // Four stored distances, from d on by `stride`, as the two sides hold them: each side
         // the voxels of its sign, read from the sign bit as a mask, and +infinity for the
         // others.
-        const auto sides = [](const float* d, int stride, F& inside, F& outside) {
+        const auto sides = [](const float* d, Index stride, F& inside, F& outside) {
             const F v = {d[0], d[stride], d[2 * stride], d[3 * stride]};
             const I bits = reinterpret_cast<I>(v), negative = bits < 0;
             const I far = reinterpret_cast<I>(F{} + kInf), distance = bits & 0x7fffffff;
@@ -584,8 +586,8 @@ class Renormalizer {
             outside = reinterpret_cast<F>((far & negative) | (distance & ~negative));
         };
         // Eight voxels of the block from b on by `step`, from d on by `stride` in a leaf.
-        const auto put = [&](const float* d, int stride, int b, int step) {
-            for (int k = 0; k < 8; k += 4) {
+        const auto put = [&](const float* d, Index stride, Index b, Index step) {
+            for (Index k = 0; k < 8; k += 4) {
                 F sideIn, sideOut;
                 sides(d + k * stride, stride, sideIn, sideOut);
                 if (step == 1) {
@@ -593,19 +595,19 @@ class Renormalizer {
                     std::memcpy(out + b + k, &sideOut, sizeof sideOut);
                     continue;
                 }
-                for (int n = 0; n < 4; ++n) {
+                for (Index n = 0; n < 4; ++n) {
                     in[b + (k + n) * step] = sideIn[n];
                     out[b + (k + n) * step] = sideOut[n];
                 }
             }
         };
-        const auto far = [&](int b, int step) {
-            for (int k = 0; k < 8; ++k)
+        const auto far = [&](Index b, Index step) {
+            for (Index k = 0; k < 8; ++k)
                 in[b + k * step] = out[b + k * step] = kInf;
         };
         const float* own = &dist_[l << 9];
-        for (int i = 0; i < 8; ++i)
-            for (int j = 0; j < 8; ++j)
+        for (Index i = 0; i < 8; ++i)
+            for (Index j = 0; j < 8; ++j)
                 put(own + i * kLeafStride[0] + j * kLeafStride[1], kLeafStride[2],
                     (i + R) * S0 + (j + R) * S1 + R, 1);
         // The rims: for each face, `rim` layers of the leaf across it (or +infinity where
@@ -614,17 +616,17 @@ class Renormalizer {
         forEachAxis([&](auto axis) {
             constexpr int a = decltype(axis)::value; // a block axis
             // The block and leaf strides of the layer's two axes, p (outer) and q.
-            constexpr int bp = a == 0 ? S1 : S0, bq = a == 2 ? S1 : 1;
-            constexpr int lp = kLeafStride[a == 0 ? 1 : 0], lq = kLeafStride[a == 2 ? 1 : 2];
-            constexpr int ba = Block::kStride[a], la = kLeafStride[a];
+            constexpr Index bp = a == 0 ? S1 : S0, bq = a == 2 ? S1 : 1;
+            constexpr Index lp = kLeafStride[a == 0 ? 1 : 0], lq = kLeafStride[a == 2 ? 1 : 2];
+            constexpr Index ba = Block::kStride[a], la = kLeafStride[a];
             for (int up = 0; up < 2; ++up) {
                 const int nl = b_.neighbourLeaf(l, 2 * kAxes[a] + up);
                 const float* from = nl < 0 ? nullptr : &dist_[std::size_t(nl) << 9];
                 for (int t = 1; t <= rim; ++t) {
                     // The block layer `at` takes the neighbour's layer `src`.
-                    const int at = (up ? 7 + t : -t) + R, src = up ? t - 1 : 8 - t;
-                    for (int p = 0; p < 8; ++p) {
-                        const int b = at * ba + (p + R) * bp + R * bq;
+                    const Index at = (up ? 7 + t : -t) + R, src = up ? t - 1 : 8 - t;
+                    for (Index p = 0; p < 8; ++p) {
+                        const Index b = at * ba + (p + R) * bp + R * bq;
                         if (from)
                             put(from + src * la + p * lp, lq, b, bq);
                         else
