@@ -580,10 +580,10 @@ class Renormalizer {
         // others.
         const auto sides = [](const float* d, Index stride, F& inside, F& outside) {
             const F v = {d[0], d[stride], d[2 * stride], d[3 * stride]};
-            const I bits = reinterpret_cast<I>(v), negative = bits < 0;
-            const I far = reinterpret_cast<I>(F{} + kInf), distance = bits & 0x7fffffff;
-            inside = reinterpret_cast<F>((distance & negative) | (far & ~negative));
-            outside = reinterpret_cast<F>((far & negative) | (distance & ~negative));
+            const I bits = reinterpret_cast<I>(v), signBit = bits < 0;
+            const I infinity = reinterpret_cast<I>(F{} + kInf), distance = bits & 0x7fffffff;
+            inside = reinterpret_cast<F>((distance & signBit) | (infinity & ~signBit));
+            outside = reinterpret_cast<F>((infinity & signBit) | (distance & ~signBit));
         };
         // Eight voxels of the block from b on by `step`, from d on by `stride` in a leaf.
         const auto put = [&](const float* d, Index stride, Index b, Index step) {
