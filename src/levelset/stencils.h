@@ -23,6 +23,10 @@ inline openvdb::Coord cubeCorner(const openvdb::Coord& base, int c) {
 // grad phi at a voxel by central differences, in world units (voxel size h): the surface
 // normal of 5.17 and the unit-gradient check of a signed distance.
 // `acc` is anything with getValue(Coord): a tree accessor, or a block of copied values.
+// One axis of it from the values one voxel below and above.
+inline float centralDifference(float below, float above, double h) {
+    return float((above - below) / (2 * h));
+}
 template <typename Accessor>
 Eigen::Vector3f centralGradient(const Accessor& acc, const openvdb::Coord& ijk, double h) {
     Eigen::Vector3f g;
@@ -30,7 +34,7 @@ Eigen::Vector3f centralGradient(const Accessor& acc, const openvdb::Coord& ijk, 
         openvdb::Coord lo = ijk, hi = ijk;
         lo[a] -= 1;
         hi[a] += 1;
-        g[a] = float((acc.getValue(hi) - acc.getValue(lo)) / (2 * h));
+        g[a] = centralDifference(acc.getValue(lo), acc.getValue(hi), h);
     }
     return g;
 }

@@ -51,9 +51,20 @@ class LeafBlock {
             [&](const openvdb::Coord& o) { return acc.getValue(o); });
     }
 
-    float getValue(const openvdb::Coord& c) const {
-        const openvdb::Coord l = c - origin_;
-        return values_[((l.x() + 1) * kSpan + l.y() + 1) * kSpan + l.z() + 1];
+    // Where leaf-local voxel (x, y, z) (-1 to 9 each) lies in the block, and the steps of
+    // that index along each axis.
+    static constexpr int index(int x, int y, int z) {
+        return ((x + 1) * kSpan + y + 1) * kSpan + z + 1;
+    }
+    static constexpr std::array<int, 3> kStep = {kSpan * kSpan, kSpan, 1};
+    float at(int i) const { return values_[std::size_t(i)]; }
+    // The central-difference gradient at the voxel of index i (see centralGradient).
+    Eigen::Vector3f gradientAt(int i, double h) const {
+        Eigen::Vector3f g;
+        for (int a = 0; a < 3; ++a)
+            g[a] =
+                centralDifference(at(i - kStep[std::size_t(a)]), at(i + kStep[std::size_t(a)]), h);
+        return g;
     }
 
     // The cubes the surface crosses (those with corners of both signs), as a voxel set of
@@ -137,12 +148,24 @@ template <typename T, std::size_t N> class LeafTable {
     std::uint32_t generation_ = 0;
 };
 
-// Cube corners of a leaf, leaf-local (0 to 8 along each axis).
+// Cube corners of a leaf, leaf-local (0 to 8 along each axis), numbered x, y, z.
 constexpr int kCorners = int(LeafNode::DIM) + 1;
-std::size_t cornerIndex(const openvdb::Coord& local) {
-    return (std::size_t(local.x()) * kCorners + std::size_t(local.y())) * kCorners +
-           std::size_t(local.z());
+constexpr int cornerIndex(int x, int y, int z) {
+    return (x * kCorners + y) * kCorners + z;
 }
+constexpr std::array<int, 3> kCornerStep = {kCorners * kCorners, kCorners, 1};
+
+// Where corner c of a cube (the numbering of mesh/mc_table: bit 0 along x, 1 along y, 2
+// along z) lies from the cube's lowest corner: in the corner numbering and in a LeafBlock.
+// A cube is meshed by adding these to its own indices, not by stepping coordinates.
+template <typename Index> constexpr std::array<int, 8> cornerOffsets(const Index& index) {
+    std::array<int, 8> out{};
+    for (int c = 0; c < 8; ++c)
+        out[std::size_t(c)] = index(c & 1, c >> 1 & 1, c >> 2 & 1) - index(0, 0, 0);
+    return out;
+}
+constexpr std::array<int, 8> kCornerOffset = cornerOffsets(cornerIndex);
+constexpr std::array<int, 8> kBlockOffset = cornerOffsets(LeafBlock::index);
 
 // The vertices a leaf's cubes have made so far, by where they lie: a crossing on the edge
 // from a cube corner along an axis, or the centre of one of a cube's cycles (a cube has at
@@ -153,12 +176,11 @@ class LeafVertices {
     static constexpr int kMaxCycles = 4;
     static constexpr std::size_t kEdges = std::size_t(kCorners) * kCorners * kCorners * 3;
     void clear() { ids_.clear(); }
-    int& onEdge(const openvdb::Coord& local, int axis) {
-        return slot(cornerIndex(local) * 3 + std::size_t(axis));
-    }
-    int& atCentre(const openvdb::Coord& local, int cycle) {
-        return slot(kEdges + std::size_t(LeafNode::coordToOffset(local)) * kMaxCycles +
-                    std::size_t(cycle));
+    // The vertex on the edge from corner `corner` (cornerIndex) along `axis`.
+    int& onEdge(int corner, int axis) { return slot(std::size_t(corner) * 3 + std::size_t(axis)); }
+    // The centre of cycle `cycle` of the cube of leaf voxel `offset`.
+    int& atCentre(int offset, int cycle) {
+        return slot(kEdges + std::size_t(offset) * kMaxCycles + std::size_t(cycle));
     }
 
   private:
@@ -175,10 +197,10 @@ class LeafVertices {
 class CornerGradients {
   public:
     void clear() { gradients_.clear(); }
-    template <typename Compute>
-    const Eigen::Vector3f& at(const openvdb::Coord& local, const Compute& compute) {
-        const std::size_t k = cornerIndex(local);
-        if (gradients_.claim(k)) gradients_[k] = compute();
+    // The gradient at corner `corner` (cornerIndex), which lies at index i of `block`.
+    const Eigen::Vector3f& at(int corner, const LeafBlock& block, int i, double h) {
+        const auto k = std::size_t(corner);
+        if (gradients_.claim(k)) gradients_[k] = block.gradientAt(i, h);
         return gradients_[k];
     }
 
@@ -215,30 +237,29 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
     chunk.normals.clear();
     chunk.edgeKeys.clear();
     chunk.triangles.clear();
-    const LeafBlock& acc = *block;
+    const LeafBlock& values = *block;
     const VoxelPlacement place(grid.transform());
     const double h = grid.voxelSize()[0];
     thread_local LeafVertices vertices;
     vertices.clear();
     thread_local CornerGradients gradients;
     gradients.clear();
-    auto gradient = [&](const openvdb::Coord& c) -> const Eigen::Vector3f& {
-        return gradients.at(c - origin, [&] { return centralGradient(acc, c, h); });
-    };
-    // Meshes the cube whose lowest corner is voxel `base`.
-    const auto meshCube = [&](const openvdb::Coord& base) {
+    // Meshes the cube of leaf voxel `offset` (its lowest corner).
+    const auto meshCube = [&](int offset) {
+        const int x = offset >> 6, y = offset >> 3 & 7, z = offset & 7;
+        const int inBlock = LeafBlock::index(x, y, z), corner = cornerIndex(x, y, z);
         float v[8];
         int mask = 0;
-        for (int c = 0; c < 8; ++c) {
-            v[c] = acc.getValue(cubeCorner(base, c));
+        for (std::size_t c = 0; c < 8; ++c) {
+            v[c] = values.at(inBlock + kBlockOffset[c]);
             if (v[c] < 0.0f) mask |= 1 << c;
         }
         // The vertex on cube edge e, created on first use.
         auto vertexOn = [&](int e) {
-            const mc::Edge& edge = mc::kEdges[e];
-            const openvdb::Coord c0 =
-                base.offsetBy(edge.c0 & 1, edge.c0 >> 1 & 1, edge.c0 >> 2 & 1);
-            int& id = vertices.onEdge(c0 - origin, edge.axis);
+            const mc::Edge& edge = mc::kEdges[std::size_t(e)];
+            const auto c0 = std::size_t(edge.c0), axis = std::size_t(edge.axis);
+            const int from = corner + kCornerOffset[c0];
+            int& id = vertices.onEdge(from, edge.axis);
             if (id < 0) {
                 id = int(chunk.positions.size());
                 // A crossing never sits on a voxel itself (a value of exactly zero there, or a
@@ -246,19 +267,21 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
                 // vertex at the same point, and the triangles between them would have no
                 // area. A thousandth of a voxel along the edge keeps them apart.
                 constexpr float kOffVoxel = 1e-3f;
-                const float a = v[edge.c0], b = v[edge.c1];
+                const float a = v[c0], b = v[std::size_t(edge.c1)];
                 const float t = std::clamp(a / (a - b), kOffVoxel, 1.0f - kOffVoxel);
-                openvdb::Vec3d p(c0.x(), c0.y(), c0.z());
-                p[edge.axis] += t;
+                const openvdb::Coord ijk = cubeCorner(origin.offsetBy(x, y, z), edge.c0);
+                openvdb::Vec3d p(ijk.x(), ijk.y(), ijk.z());
+                p[axis] += t;
                 const openvdb::Vec3d w = place.toWorld(p);
                 chunk.positions.emplace_back(float(w.x()), float(w.y()), float(w.z()));
-                openvdb::Coord c1 = c0;
-                c1[edge.axis] += 1;
-                const Eigen::Vector3f n = (1 - t) * gradient(c0) + t * gradient(c1);
+                const int at0 = inBlock + kBlockOffset[c0];
+                const Eigen::Vector3f n = (1 - t) * gradients.at(from, values, at0, h) +
+                                          t * gradients.at(from + kCornerStep[axis], values,
+                                                           at0 + LeafBlock::kStep[axis], h);
                 const float len = n.norm();
                 chunk.normals.push_back(len > 0 ? Eigen::Vector3f(n / len)
                                                 : Eigen::Vector3f(0, 0, 1));
-                chunk.edgeKeys.push_back(makeKey(c0, edge.axis));
+                chunk.edgeKeys.push_back(makeKey(ijk, edge.axis));
             }
             return id;
         };
@@ -266,22 +289,24 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
         int ids[3];
         for (const auto& tri : cube.triangles) {
             for (int k = 0; k < 3; ++k) {
-                const int e = tri[k];
+                const int e = tri[std::size_t(k)];
                 if (e >= mc::kCentre) {
                     // A cycle's centre: never shared with another cube.
                     const int cycle = e - mc::kCentre;
-                    int& id = vertices.atCentre(base - origin, cycle);
+                    int& id = vertices.atCentre(offset, cycle);
                     if (id < 0) {
                         Eigen::Vector3f p = Eigen::Vector3f::Zero(), nrm = Eigen::Vector3f::Zero();
-                        for (std::uint8_t ce : cube.cycles[cycle]) {
+                        for (std::uint8_t ce : cube.cycles[std::size_t(cycle)]) {
                             const int vi = vertexOn(ce);
-                            p += chunk.positions[vi];
-                            nrm += chunk.normals[vi];
+                            p += chunk.positions[std::size_t(vi)];
+                            nrm += chunk.normals[std::size_t(vi)];
                         }
                         id = int(chunk.positions.size());
-                        chunk.positions.push_back(p / float(cube.cycles[cycle].size()));
+                        chunk.positions.push_back(p /
+                                                  float(cube.cycles[std::size_t(cycle)].size()));
                         chunk.normals.push_back(nrm.normalized());
-                        chunk.edgeKeys.push_back(makeKey(base, 3) | (std::uint64_t(cycle) << 62));
+                        chunk.edgeKeys.push_back(makeKey(origin.offsetBy(x, y, z), 3) |
+                                                 (std::uint64_t(cycle) << 62));
                     }
                     ids[k] = id;
                 } else {
@@ -296,7 +321,7 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
         for (leafwords::Word cubes =
                  crossing[std::size_t(x)] & leaf->getValueMask().getWord<leafwords::Word>(x);
              cubes; cubes &= cubes - 1)
-            meshCube(leaf->offsetToGlobalCoord(openvdb::Index(x * 64 + __builtin_ctzll(cubes))));
+            meshCube(x * 64 + __builtin_ctzll(cubes));
     // (assign keeps the chunk's storage where it is large enough, as re-meshing wants.)
     into.positions.assign(chunk.positions.begin(), chunk.positions.end());
     into.normals.assign(chunk.normals.begin(), chunk.normals.end());
