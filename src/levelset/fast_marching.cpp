@@ -521,17 +521,21 @@ class Renormalizer {
                 d = float(h / std::sqrt(inv2)); // distance to the plane through the crossings
             }
             dist_[i] = signedAs(negative(p), d);
-            ++count.local();
             return true;
         };
-        // Only voxels with a face neighbour across the surface can be seeds.
+        // Only voxels with a face neighbour across the surface can be seeds. (Counted a leaf
+        // at a time: the thread's counter is a lookup in a table.)
         forEachLeaf([&](std::size_t l) {
             Bits candidates = acrossSurface(l, false);
             for (int x = 0; x < 8; ++x)
                 candidates[x] &= ~settled_[l][x] & ~beyond_[l][x];
+            std::size_t n = 0;
             forEachBit(candidates, [&](int off) {
-                if (seedOne((l << 9) + std::size_t(off))) set(settled_[l], off);
+                if (!seedOne((l << 9) + std::size_t(off))) return;
+                set(settled_[l], off);
+                ++n;
             });
+            count.local() += n;
         });
         return count.combine(std::plus<>());
     }
