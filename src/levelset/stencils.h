@@ -20,13 +20,15 @@ inline openvdb::Coord cubeCorner(const openvdb::Coord& base, int c) {
     return base.offsetBy(c & 1, c >> 1 & 1, c >> 2 & 1);
 }
 
-// grad phi at a voxel by central differences, in world units (voxel size h): the surface
-// normal of 5.17 and the unit-gradient check of a signed distance.
-// `acc` is anything with getValue(Coord): a tree accessor, or a block of copied values.
-// One axis of it from the values one voxel below and above.
+// One axis of the central-difference gradient below, from the values one voxel below and
+// above.
 inline float centralDifference(float below, float above, double h) {
     return float((above - below) / (2 * h));
 }
+
+// grad phi at a voxel by central differences, in world units (voxel size h): the surface
+// normal of 5.17 and the unit-gradient check of a signed distance.
+// `acc` is anything with getValue(Coord): a tree accessor, or a block of copied values.
 template <typename Accessor>
 Eigen::Vector3f centralGradient(const Accessor& acc, const openvdb::Coord& ijk, double h) {
     Eigen::Vector3f g;
