@@ -221,6 +221,11 @@ float signedAs(bool inside, float d) {
     return inside ? -d : d;
 }
 
+// Four floats, and four lanes of a mask (GCC's vector extensions; SSE2 on x86-64): blocks are
+// filled and distances written back four values at a time.
+using Floats4 = float __attribute__((vector_size(16)));
+using Lanes4 = std::int32_t __attribute__((vector_size(16)));
+
 // One leaf of the domain and a rim of two voxels taken from its six face neighbours, in a
 // dense block: the upwind stencils (which reach two voxels along each axis) read their
 // neighbours by fixed strides, without branching on leaf borders. Each side of the surface
@@ -578,8 +583,8 @@ class Renormalizer {
         constexpr Index S0 = Block::kStride[0], S1 = Block::kStride[1];
         float* in = block.side[1].data();
         float* out = block.side[0].data();
-        using F = float __attribute__((vector_size(16)));
-        using I = std::int32_t __attribute__((vector_size(16)));
+        using F = Floats4;
+        using I = Lanes4;
         // Four stored distances, from d on by `stride`, as the two sides hold them: each side
         // the voxels of its sign, read from the sign bit as a mask, and +infinity for the
         // others.
@@ -872,14 +877,12 @@ class Renormalizer {
             // Only the free voxels, straight into the leaf's buffer and its mask a word at a
             // time (most of a domain is boundary; a setValueOn per voxel checked whether the
             // buffer was in memory every time). Four voxels at once: each distance capped at
-            // the background, given its side's sign, and kept where the voxel is not free.
-            using F = float __attribute__((vector_size(16)));
-            using I = std::int32_t __attribute__((vector_size(16)));
+            // the background, keeping its sign (its side: signedAs), and kept where the voxel
+            // is not free.
+            using F = Floats4;
+            using I = Lanes4;
             const I laneBit = {1, 2, 4, 8}, signBit = I{} + std::numeric_limits<int>::min();
             const F bg = F{} + bg_;
-            const auto lanes = [&](std::uint64_t word, int k) {
-                return ((I{} + int((word >> k) & 15u)) & laneBit) != 0;
-            };
             Leaf& leaf = b_.leaf(l);
             float* values = leaf.buffer().data();
             auto& mask = leaf.getValueMask();
@@ -888,7 +891,6 @@ class Renormalizer {
             for (int x = 0; x < 8; ++x) {
                 const std::uint64_t free = ~fixed_[l][std::size_t(x)];
                 if (!free) continue;
-                const std::uint64_t inside = neg_[l][std::size_t(x)];
                 std::uint64_t band = 0; // the free voxels within the band
                 for (int k = 0; k < 64; k += 4) {
                     if (!((free >> k) & 15u)) continue;
@@ -897,11 +899,12 @@ class Renormalizer {
                     F d, was;
                     std::memcpy(&d, dist + at, sizeof d);
                     std::memcpy(&was, to, sizeof was);
-                    const F a = reinterpret_cast<F>(reinterpret_cast<I>(d) & ~signBit);
-                    const I within = a < bg, mine = lanes(free, k);
+                    const I bits = reinterpret_cast<I>(d);
+                    const F a = reinterpret_cast<F>(bits & ~signBit);
+                    const I within = a < bg;
+                    const I mine = ((I{} + int((free >> k) & 15u)) & laneBit) != 0;
                     const F capped = within ? a : bg;
-                    const F v = reinterpret_cast<F>(reinterpret_cast<I>(capped) |
-                                                    (lanes(inside, k) & signBit));
+                    const F v = reinterpret_cast<F>(reinterpret_cast<I>(capped) | (bits & signBit));
                     const F out = mine ? v : was;
                     std::memcpy(to, &out, sizeof out);
                     band |= std::uint64_t(
