@@ -75,8 +75,9 @@ class SculptController {
     // A pinch's falloff is at least this many voxels (see topologyStroke).
     static constexpr double kMinPinchFalloffVoxels = 16.0;
 
-    // waitEachPiece: every piece of sculpting is finished before the next event is taken
-    // (replays and tests: deterministic); otherwise events coalesce while one runs.
+    // waitEachPiece: every piece of sculpting is finished, on the caller's thread, before the
+    // next event is taken (replays and tests: deterministic); otherwise pieces run on a
+    // worker thread and events coalesce while one runs.
     explicit SculptController(bool waitEachPiece = false) : waitEach_(waitEachPiece) {}
     ~SculptController() { wait(); }
 
