@@ -34,6 +34,9 @@ double peakResidentBytes() {
 }
 
 bool restartPeakResident() {
+#if defined(__GLIBC__)
+    malloc_trim(0);
+#endif
     std::ofstream refs("/proc/self/clear_refs");
     refs << "5"; // resets the peak resident set size to the current one
     refs.flush();

@@ -25,9 +25,10 @@ double availableMemoryBytes();
 
 // The process's peak resident memory (VmHWM), in bytes; 0 when it cannot be read.
 double peakResidentBytes();
-// Starts the peak over from the memory resident now, so that peakResidentBytes() measures
-// one piece of work (Linux's clear_refs). False when the kernel refused: the peak then
-// stays the process's own since it started.
+// Starts the peak over, so that peakResidentBytes() measures one piece of work: the memory
+// the process keeps freed (keepFreedMemory) goes back to the kernel first, or the work
+// before would count in it, then the peak restarts from what is resident (Linux's
+// clear_refs). False when the kernel refused: the peak then stays the process's own.
 bool restartPeakResident();
 
 // Keeps the memory the process frees for its next allocations instead of handing it back

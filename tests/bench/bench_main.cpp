@@ -254,7 +254,7 @@ int main(int argc, char** argv) {
     benchmark::Initialize(&n, rest.data());
     if (benchmark::ReportUnrecognizedArguments(n, rest.data())) return 2;
 
-    registerDragBenchmarks(); // first: its peak memory is then its own
+    registerDragBenchmarks();
     registerScaleBenchmarks();
     registerAdvectBenchmarks();
     registerRenormalizeBenchmarks();

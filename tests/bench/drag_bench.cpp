@@ -2,18 +2,16 @@
 // ball tool of radius 0.25 on the unit sphere, replayed as the modeler does it (advect,
 // renormalize, re-mesh the touched leaves after every segment), at every size of the run
 // and one twice as fine as the finest. Reports the latency of a segment, p50 and p95,
-// split by stage, and the process's peak memory.
+// split by stage, and the case's peak memory.
 //
 // The scale group: the first 20 segments of the same drag at voxel size 1/128 on spheres
 // of radius 1, 2 and 4 (the drag moved out to the surface): a segment must cost what the
 // brush touches, not what the model holds.
-#include <sys/resource.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <fstream>
+#include <cstdio>
 
 #include "bench.h"
+#include "core/memory.h"
 #include "core/statistics.h"
 #include "io/start_grid.h"
 #include "io/stroke_script.h"
@@ -41,13 +39,16 @@ void addSegmentCounters(benchmark::State& state, const std::vector<SegmentReport
     state.counters["segments"] = double(reports.size());
 }
 
-// Resident memory now (the peak of the process only grows, so it cannot tell the runs of
-// a group apart).
-double residentMegabytes() {
-    std::ifstream statm("/proc/self/statm");
-    double pages = 0, resident = 0;
-    statm >> pages >> resident;
-    return resident * double(sysconf(_SC_PAGESIZE)) / (1 << 20);
+// Starts the case's own count of peak memory (what earlier cases freed and the heap kept
+// is handed back first); the counter says so where the kernel refused, rather than
+// reporting the process's peak as the case's.
+void startPeak() {
+    if (!restartPeakResident())
+        std::fprintf(stderr, "peak_rss_mb: the kernel would not restart the peak count, so "
+                             "it is the process's peak\n");
+}
+double peakMegabytes() {
+    return peakResidentBytes() / double(1 << 20);
 }
 
 } // namespace
@@ -67,19 +68,19 @@ void registerScaleBenchmarks() {
                     p.t.z() += radius - 1.0; // the drag runs over the front of the sphere
                 std::vector<SegmentReport> reports;
                 GridPtr grid;
-                double rss = 0.0;
                 for (auto _ : state) {
                     state.PauseTiming();
+                    grid.reset();
+                    startPeak();
                     grid = makeStartGrid(script, SWEEPERS_DATA_DIR, 1.0 / 128);
                     Sculptor sculptor(grid);
                     sculptor.startMeshing();
                     state.ResumeTiming();
                     reports = applyStrokes(sculptor, script.strokes);
-                    rss = residentMegabytes();
                 }
                 addSegmentCounters(state, reports);
                 state.counters["active_voxels"] = double(grid->activeVoxelCount());
-                state.counters["rss_mb"] = rss;
+                state.counters["peak_rss_mb"] = peakMegabytes();
             },
             1);
     }
@@ -100,6 +101,8 @@ void registerDragBenchmarks() {
                 GridPtr grid;
                 for (auto _ : state) {
                     state.PauseTiming();
+                    grid.reset();
+                    startPeak();
                     grid = makeStartGrid(script, SWEEPERS_DATA_DIR, 1.0 / div);
                     Sculptor sculptor(grid);
                     sculptor.startMeshing();
@@ -108,9 +111,7 @@ void registerDragBenchmarks() {
                 }
                 addSegmentCounters(state, reports);
                 state.counters["active_voxels"] = double(grid->activeVoxelCount());
-                rusage usage{};
-                getrusage(RUSAGE_SELF, &usage);
-                state.counters["peak_rss_mb"] = double(usage.ru_maxrss) / 1024.0;
+                state.counters["peak_rss_mb"] = peakMegabytes();
             },
             1);
     }

@@ -3,6 +3,7 @@
 #include <cstring>
 
 #include <memory>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <sys/mman.h>
@@ -63,6 +64,26 @@ TEST(Memory, FreedMemoryIsKeptForTheNextAllocation) {
     const long faults = minorFaults() - before;
     std::printf("[ memory ] %ld page faults writing %zu pages a second time\n", faults, kPages);
     EXPECT_LT(faults, long(kPages / 20));
+}
+
+TEST(Memory, ThePeakOfAPieceOfWorkLeavesOutWhatTheWorkBeforeFreed) {
+    if (kAddressSanitizer)
+        GTEST_SKIP() << "AddressSanitizer's allocator does not take glibc's settings";
+    keepFreedMemory();
+    // 192 MB in blocks the heap gives (below the mapping threshold), all freed: the heap
+    // keeps them, resident, for the next allocations.
+    constexpr std::size_t kBlock = std::size_t(24) << 20, kBlocks = 8;
+    {
+        std::vector<std::unique_ptr<char[]>> blocks;
+        for (std::size_t i = 0; i < kBlocks; ++i) {
+            blocks.emplace_back(new char[kBlock]);
+            sink = blocks.back().get();
+            std::memset(sink, 1, kBlock);
+        }
+    }
+    const double withBlocks = peakResidentBytes();
+    ASSERT_TRUE(restartPeakResident());
+    EXPECT_LT(peakResidentBytes(), withBlocks - 0.75 * double(kBlock * kBlocks));
 }
 
 } // namespace
