@@ -159,12 +159,28 @@ inline std::size_t floodSignsIn(Grid::TreeType& tree, const std::vector<LeafNode
         for (std::size_t l = r.begin(); l != r.end(); ++l)
             floodLeafSigns(*leaves[l], inside, outside);
     });
+    // Each node reads only its own children, so the nodes of a level are filled in parallel
+    // too: one after the other they took 0.57-0.63 ms of a drag segment at 1/128 (the four
+    // upper nodes of 32768 tiles a stroke near the origin crosses 0.24-0.27 of it), in
+    // parallel 0.21-0.34.
+    using Upper = Grid::TreeType::RootNodeType::ChildNodeType;
+    using Lower = Upper::ChildNodeType;
+    std::vector<Upper*> uppers;
+    std::vector<Lower*> lowers;
     for (auto upper = tree.root().beginChildOn(); upper; ++upper) {
         if (!box.hasOverlap(upper->getNodeBoundingBox())) continue;
+        uppers.push_back(&*upper);
         for (auto lower = upper->beginChildOn(); lower; ++lower)
-            if (box.hasOverlap(lower->getNodeBoundingBox())) fill(*lower);
-        fill(*upper);
+            if (box.hasOverlap(lower->getNodeBoundingBox())) lowers.push_back(&*lower);
     }
+    const auto fillAll = [&](const auto& nodes) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes.size(), 1), [&](const auto& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i)
+                fill(*nodes[i]);
+        });
+    };
+    fillAll(lowers);
+    fillAll(uppers);
     fill(tree.root()); // the root's tiles between its (few) children
     return leaves.size();
 }
