@@ -497,7 +497,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         // Found leaf by leaf in parallel, then listed in leaf order (the stretch samples
         // every fourth one of that list): each leaf's voxels counted first, then written
         // where the counts before it put them (a list per leaf, joined on one thread, took
-        // about a twentieth of the band's growth at 1/128).
+        // 0.12-0.17 ms of the 1.9 ms band growth of a drag segment at 1/128).
         const auto leaves = leavesIn(std::as_const(grid.tree()), region);
         std::vector<LeafNode::NodeMaskType> crossing(leaves.size());
         std::vector<std::size_t> first(leaves.size() + 1, 0);
