@@ -246,7 +246,9 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
     gradients.clear();
     // Meshes the cube of leaf voxel `offset` (its lowest corner).
     const auto meshCube = [&](int offset) {
-        const int x = offset >> 6, y = offset >> 3 & 7, z = offset & 7;
+        const openvdb::Coord local = LeafNode::offsetToLocalCoord(openvdb::Index(offset));
+        const int x = local.x(), y = local.y(), z = local.z();
+        const openvdb::Coord base = origin + local;
         const int inBlock = LeafBlock::index(x, y, z), corner = cornerIndex(x, y, z);
         float v[8];
         int mask = 0;
@@ -269,7 +271,7 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
                 constexpr float kOffVoxel = 1e-3f;
                 const float a = v[c0], b = v[std::size_t(edge.c1)];
                 const float t = std::clamp(a / (a - b), kOffVoxel, 1.0f - kOffVoxel);
-                const openvdb::Coord ijk = cubeCorner(origin.offsetBy(x, y, z), edge.c0);
+                const openvdb::Coord ijk = cubeCorner(base, edge.c0);
                 openvdb::Vec3d p(ijk.x(), ijk.y(), ijk.z());
                 p[axis] += t;
                 const openvdb::Vec3d w = place.toWorld(p);
@@ -305,8 +307,7 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
                         chunk.positions.push_back(p /
                                                   float(cube.cycles[std::size_t(cycle)].size()));
                         chunk.normals.push_back(nrm.normalized());
-                        chunk.edgeKeys.push_back(makeKey(origin.offsetBy(x, y, z), 3) |
-                                                 (std::uint64_t(cycle) << 62));
+                        chunk.edgeKeys.push_back(makeKey(base, 3) | (std::uint64_t(cycle) << 62));
                     }
                     ids[k] = id;
                 } else {
