@@ -469,7 +469,8 @@ openvdb::CoordBBox indexBox(const Grid& grid, const Box& world, int pad) {
                               openvdb::Coord::ceil(hi).offsetBy(pad));
 }
 
-AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOptions& options) {
+AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOptions& options,
+                          std::vector<openvdb::CoordBBox>* changedBoxes) {
     AdvectStats stats;
     stats.subSteps = seg.steps();
     const double h = grid.voxelSize()[0];
@@ -780,6 +781,29 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     }
     stats.renormalizeSeconds = secondsSince(t0);
     stats.touched = touched;
+    if (changedBoxes) {
+        // Sampling changed the band's voxels in `changed` and switched on those of `fresh`;
+        // renormalization, where it ran, wrote within `changed` (grown by then to hold `fresh`)
+        // and one step past it, where the band may grow. The sign floods and the pruning of
+        // emptied leaves change inactive values only.
+        changedBoxes->clear();
+        const int margin = options.renormalize ? 1 : 0;
+        for (const openvdb::MaskTree* mask : {&changed->tree(), &fresh->tree()}) {
+            if (options.renormalize && mask == &fresh->tree()) continue; // within `changed`
+            for (auto it = mask->cbeginLeaf(); it; ++it) {
+                leafwords::Words on;
+                for (int x = 0; x < 8; ++x)
+                    on[std::size_t(x)] = it->getValueMask().getWord<leafwords::Word>(x);
+                if (!leafwords::any(on)) continue;
+                int lo[3], hi[3];
+                leafwords::bounds(on, lo, hi);
+                const openvdb::Coord o = it->origin();
+                changedBoxes->emplace_back(
+                    o.offsetBy(lo[0] - margin, lo[1] - margin, lo[2] - margin),
+                    o.offsetBy(hi[0] + margin, hi[1] + margin, hi[2] + margin));
+            }
+        }
+    }
     return stats;
 }
 

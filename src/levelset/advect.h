@@ -18,6 +18,8 @@
 // flood fill and the box is renormalized.
 #pragma once
 
+#include <vector>
+
 #include "deform/step_deformation.h"
 #include "levelset/fast_marching.h"
 #include "levelset/interrupt.h"
@@ -54,8 +56,14 @@ struct AdvectStats {
     openvdb::CoordBBox touched; // index box whose values may have changed
 };
 
+// With `changed`, it is given boxes (each within a voxel of one leaf) that hold every voxel
+// active before or after the segment whose value or active state changed: what a mesh kept
+// up to date reads again (SurfaceMesher::update). Inactive values (the signs the flood
+// re-derives, tiles) are left out: the band is valid before and after, and a valid band has
+// no inactive voxel within two voxels of its surface, as far as the mesh of a leaf reads.
 AdvectStats advectSegment(Grid& grid, const StepDeformation& segment,
-                          const AdvectOptions& options = {});
+                          const AdvectOptions& options = {},
+                          std::vector<openvdb::CoordBBox>* changed = nullptr);
 
 // The index box whose voxels advectSegment(grid, segment) may change (what undo saves).
 openvdb::CoordBBox changedRegion(const Grid& grid, const StepDeformation& segment);

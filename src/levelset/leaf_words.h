@@ -45,6 +45,31 @@ inline bool any(const Words& set) {
     return all != 0;
 }
 
+// The smallest leaf-local box holding every voxel of a set that holds one: lo and hi (bounds
+// included) along x, y and z, read from the words (the set's union folds into its rows).
+inline void bounds(const Words& set, int (&lo)[3], int (&hi)[3]) {
+    Word all = 0;
+    int first = 8, last = -1;
+    for (int x = 0; x < 8; ++x)
+        if (set[std::size_t(x)]) {
+            all |= set[std::size_t(x)];
+            first = std::min(first, x);
+            last = x;
+        }
+    unsigned rows = 0, cols = 0; // bit y: row y holds a voxel; bit z: some row holds z
+    for (int y = 0; y < 8; ++y) {
+        const unsigned row = unsigned(all >> (8 * y)) & 0xffu;
+        rows |= unsigned(row != 0) << y;
+        cols |= row;
+    }
+    lo[0] = first;
+    hi[0] = last;
+    lo[1] = __builtin_ctz(rows);
+    hi[1] = 31 - __builtin_clz(rows);
+    lo[2] = __builtin_ctz(cols);
+    hi[2] = 31 - __builtin_clz(cols);
+}
+
 // Word x of the set `own` seen one step along axis A (dir = +-1): its bit for a voxel is the
 // bit of the voxel one step away. Past the leaf's face it reads `facing`, the layer of the
 // next leaf that faces it, laid out as that axis needs it: along x the whole word, along y

@@ -44,6 +44,10 @@ class SurfaceMesher {
     // Re-meshes the leaves overlapping `touched` grown by two voxels (as far as a leaf's
     // normals read) whose values changed; returns how many chunks were made or emptied.
     std::size_t update(const Grid& grid, const openvdb::CoordBBox& touched);
+    // Re-meshes the leaves whose cubes or normals read a voxel of one of the boxes and whose
+    // values changed. For small boxes, such as the box per leaf in which advectSegment reports
+    // what a segment changed: the leaves a stroke changed, not every leaf of its box.
+    std::size_t update(const Grid& grid, const std::vector<openvdb::CoordBBox>& changed);
 
     const std::map<openvdb::Coord, MeshChunk>& chunks() const { return chunks_; }
     // The changes since the last call (a renderer re-uploads only those).

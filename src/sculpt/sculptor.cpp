@@ -42,11 +42,11 @@ SegmentReport Sculptor::applySegment(const StepDeformation& deformation) {
     if (recording_) record_.capture(*grid_, changedRegion(*grid_, deformation));
     SegmentReport r;
     const auto t0 = Clock::now();
-    r.stats = advectSegment(*grid_, deformation, options_);
+    r.stats = advectSegment(*grid_, deformation, options_, meshing_ ? &changed_ : nullptr);
     r.seconds = secondsSince(t0);
     if (meshing_) {
         const auto t1 = Clock::now();
-        r.remeshedLeaves = mesher_.update(*grid_, r.stats.touched);
+        r.remeshedLeaves = mesher_.update(*grid_, changed_);
         r.meshSeconds = secondsSince(t1);
     }
     return r;

@@ -78,6 +78,7 @@ class Sculptor {
     SurfaceMesher mesher_;
     bool meshing_ = false, recording_ = false;
     LeafSnapshot record_;
+    std::vector<openvdb::CoordBBox> changed_; // what a segment changed, for the mesher
 };
 
 // The deformations a run applied, in order.

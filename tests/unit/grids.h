@@ -1,7 +1,9 @@
 // Analytic level sets for the engine tests, built voxel by voxel from exact distances.
 #pragma once
 
+#include <cstring>
 #include <functional>
+#include <vector>
 
 #include <openvdb/tools/SignedFloodFill.h>
 
@@ -41,6 +43,29 @@ inline std::size_t differingVoxels(const Grid& a, const Grid& b) {
     std::size_t n = 0;
     for (auto it = box.begin(); it; ++it)
         n += ca.getValue(*it) != cb.getValue(*it) || ca.isValueOn(*it) != cb.isValueOn(*it);
+    return n;
+}
+
+// The voxels active in either grid whose value (to the bit) or state differs, that lie in
+// none of `boxes`.
+inline std::size_t changedOutside(const Grid& a, const Grid& b,
+                                  const std::vector<openvdb::CoordBBox>& boxes) {
+    openvdb::MaskTree inside;
+    for (const openvdb::CoordBBox& box : boxes)
+        inside.sparseFill(box, true, true);
+    openvdb::CoordBBox all = a.evalActiveVoxelBoundingBox();
+    all.expand(b.evalActiveVoxelBoundingBox());
+    all.expand(8);
+    auto ca = a.getConstAccessor();
+    auto cb = b.getConstAccessor();
+    openvdb::tree::ValueAccessor<const openvdb::MaskTree> in(inside);
+    std::size_t n = 0;
+    for (auto it = all.begin(); it; ++it) {
+        const bool onA = ca.isValueOn(*it), onB = cb.isValueOn(*it);
+        const float va = ca.getValue(*it), vb = cb.getValue(*it);
+        n += (onA || onB) && (std::memcmp(&va, &vb, sizeof va) != 0 || onA != onB) &&
+             !in.isValueOn(*it);
+    }
     return n;
 }
 

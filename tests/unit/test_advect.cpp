@@ -384,6 +384,70 @@ TEST(Advect, ASegmentRenormalizesEverythingItChanged) {
     EXPECT_LT(largest, 1e-5); // the solve's tolerance is 1e-6 voxel
 }
 
+// What a segment reports it changed holds every voxel of the band (before or after) whose
+// value or state it changed, what a mesh kept up to date reads again, for every kind of
+// segment: a drag, a drag resampled per sub-step or left without renormalization, a squeeze
+// that widens the band, a pinch that tears the shape, an inflation. And it is less than the
+// segment's box: the drag's boxes hold a part of the voxels of its box.
+TEST(Advect, ASegmentReportsEveryVoxelItChanged) {
+    const double h = 1.0 / 32;
+    const auto check = [&](const char* what, Grid& g, const StepDeformation& seg,
+                           const AdvectOptions& options) {
+        const GridPtr before = g.deepCopy();
+        std::vector<openvdb::CoordBBox> boxes;
+        const AdvectStats stats = advectSegment(g, seg, options, &boxes);
+        EXPECT_EQ(sweepers::test::changedOutside(*before, g, boxes), 0u) << what;
+        EXPECT_GT(sweepers::test::differingVoxels(*before, g), 0u) << what; // it did change
+        openvdb::MaskTree reported;
+        for (const openvdb::CoordBBox& box : boxes)
+            reported.sparseFill(box, true, true);
+        std::printf("[ advect ] %s: %zu boxes, %llu voxels, of the %llu of its box\n", what,
+                    boxes.size(), (unsigned long long)reported.activeVoxelCount(),
+                    (unsigned long long)stats.touched.volume());
+        return double(reported.activeVoxelCount()) / double(stats.touched.volume());
+    };
+    const Sweep drag{{{std::make_shared<EllipsoidShape>(0.3),
+                       0.3,
+                       {at({0, 1, 0}), at({0.05, 1.1, 0}), at({0.1, 1.2, 0.02})}}}};
+    for (const bool perSubStep : {false, true})
+        for (const bool renormalize : {true, false}) {
+            GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+            AdvectOptions o;
+            o.resampleEachSubStep = perSubStep;
+            o.renormalize = renormalize;
+            for (std::size_t k = 0; k < drag.segmentCount(); ++k) {
+                const double part = check(perSubStep    ? "drag, per sub-step"
+                                          : renormalize ? "drag"
+                                                        : "drag, not renormalized",
+                                          *g, SweepSegment(drag, k), o);
+                if (!perSubStep && renormalize) {
+                    EXPECT_LT(part, 0.7);
+                }
+            }
+        }
+    {
+        GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+        Placement squeezed;
+        squeezed.scale = Eigen::Vector3d(0.4, 1.0, 1.0);
+        Sweep sweep{{{std::make_shared<EllipsoidShape>(1.25), 0.4, {at({0, 0, 0}), squeezed}}}};
+        check("squeeze (band widened)", *g, SweepSegment(sweep, 0), {});
+    }
+    {
+        GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+        PinchSpec spec;
+        spec.axis = Eigen::Vector3d::UnitY();
+        spec.size = 1.1;
+        spec.falloff = 0.3;
+        spec.open = 0.15;
+        for (const auto& part : planPinch(spec, h))
+            check("pinch", *g, *part, {});
+    }
+    {
+        GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+        check("inflation", *g, Inflation({0.5, 0, 0}, 0.3, activeWorldBox(*g).expanded(2 * h)), {});
+    }
+}
+
 // A grid's copy (Grid::deepCopy, a file read back) must sculpt to the same voxels as the
 // grid itself, at voxel sizes that are not powers of two too: copying a transform once
 // moved 1/24 by a unit in the last place, and with it every sample point and the band's

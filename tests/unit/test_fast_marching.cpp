@@ -368,6 +368,31 @@ TEST(LeafWords, NegativesAreTheSignsOfTheValues) {
     }
 }
 
+// The bounds of a leaf's voxel set are those of its voxels, one by one (sets of one voxel,
+// a few, and many).
+TEST(LeafWords, BoundsAreThoseOfTheVoxels) {
+    std::mt19937 random(17);
+    std::uniform_int_distribution<int> voxel(0, 511), count(1, 40);
+    for (int trial = 0; trial < 500; ++trial) {
+        leafwords::Words set{};
+        int want[2][3] = {{8, 8, 8}, {-1, -1, -1}};
+        for (int n = trial < 100 ? 1 : count(random); n > 0; --n) {
+            const int v = voxel(random), c[3] = {v >> 6, (v >> 3) & 7, v & 7};
+            set[std::size_t(c[0])] |= leafwords::Word(1) << (v & 63);
+            for (int a = 0; a < 3; ++a) {
+                want[0][a] = std::min(want[0][a], c[a]);
+                want[1][a] = std::max(want[1][a], c[a]);
+            }
+        }
+        int lo[3], hi[3];
+        leafwords::bounds(set, lo, hi);
+        for (int a = 0; a < 3; ++a) {
+            ASSERT_EQ(lo[a], want[0][a]) << "trial " << trial << ", axis " << a;
+            ASSERT_EQ(hi[a], want[1][a]) << "trial " << trial << ", axis " << a;
+        }
+    }
+}
+
 // A leaf's inactive values take the signs OpenVDB's signed flood fill gives them, to the bit:
 // leaves with no active voxel, a few, half, nearly all and all of them, values of both signs
 // with zeros of either sign, infinities and NaN among them.

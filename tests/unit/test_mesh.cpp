@@ -163,12 +163,26 @@ TEST(MarchingCubes, IncrementalUpdateMatchesRebuild) {
     a.t = {0, 0.9, 0};
     b.t = {0.1, 1.3, 0};
     const auto ball = std::make_shared<EllipsoidShape>(0.3);
+    // The mesher updated from what each segment reports it changed (as a Sculptor updates it)
+    // holds the same chunks too.
+    SurfaceMesher fromChanges;
+    fromChanges.rebuild(*g);
     for (const Sweep& sweep : {Sweep{{{ball, 0.3, {a, b}}}}, Sweep{{{ball, 0.3, {b, a}}}}}) {
-        const AdvectStats stats = advectSegment(*g, SweepSegment(sweep, 0));
+        std::vector<openvdb::CoordBBox> changed;
+        const AdvectStats stats = advectSegment(*g, SweepSegment(sweep, 0), {}, &changed);
         const std::size_t remeshed = incremental.update(*g, stats.touched);
+        EXPECT_EQ(fromChanges.update(*g, changed), remeshed);
         SurfaceMesher full;
         full.rebuild(*g);
         EXPECT_LT(remeshed, g->tree().leafCount() / 2); // only the stroke's neighbourhood
+        ASSERT_EQ(fromChanges.chunks().size(), full.chunks().size());
+        for (const auto& [origin, chunk] : full.chunks()) {
+            const auto it = fromChanges.chunks().find(origin);
+            ASSERT_NE(it, fromChanges.chunks().end()) << origin;
+            EXPECT_EQ(it->second.triangles, chunk.triangles) << origin;
+            EXPECT_EQ(it->second.positions, chunk.positions) << origin;
+            EXPECT_EQ(it->second.normals, chunk.normals) << origin;
+        }
         const TriangleMesh x = incremental.weld(), y = full.weld();
         ASSERT_EQ(x.triangles.size(), y.triangles.size());
         ASSERT_EQ(x.positions.size(), y.positions.size());
@@ -197,8 +211,9 @@ TEST(MarchingCubes, ALeafIsMeshedAgainExactlyWhenWhatItReadsChanged) {
     // nothing.
     const double h = 1.0 / 16;
     GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
-    SurfaceMesher incremental;
+    SurfaceMesher incremental, fromChanges;
     incremental.rebuild(*g);
+    fromChanges.rebuild(*g);
     const openvdb::Coord origin = incremental.chunks().begin()->first;
     const openvdb::CoordBBox around(origin.offsetBy(-2), origin.offsetBy(LeafNode::DIM + 2));
     EXPECT_EQ(incremental.update(*g, around), 0u);
@@ -211,18 +226,23 @@ TEST(MarchingCubes, ALeafIsMeshedAgainExactlyWhenWhatItReadsChanged) {
                 const float was = acc.getValue(c);
                 if (!acc.isValueOn(c)) continue; // the band's values only
                 acc.setValue(c, 0.7f * was);
+                // Told of the voxel as a box to look around, and as what changed.
                 incremental.update(*g, openvdb::CoordBBox(c, c));
+                fromChanges.update(*g, std::vector{openvdb::CoordBBox(c, c)});
                 SurfaceMesher full;
                 full.rebuild(*g);
-                const auto it = incremental.chunks().find(origin);
                 const auto want = full.chunks().find(origin);
-                ASSERT_NE(it, incremental.chunks().end());
                 ASSERT_NE(want, full.chunks().end());
-                EXPECT_EQ(it->second.positions, want->second.positions) << c;
-                EXPECT_EQ(it->second.normals, want->second.normals) << c;
-                EXPECT_EQ(it->second.triangles, want->second.triangles) << c;
+                for (const SurfaceMesher* m : {&incremental, &fromChanges}) {
+                    const auto it = m->chunks().find(origin);
+                    ASSERT_NE(it, m->chunks().end());
+                    EXPECT_EQ(it->second.positions, want->second.positions) << c;
+                    EXPECT_EQ(it->second.normals, want->second.normals) << c;
+                    EXPECT_EQ(it->second.triangles, want->second.triangles) << c;
+                }
                 acc.setValue(c, was);
                 incremental.update(*g, openvdb::CoordBBox(c, c));
+                fromChanges.update(*g, std::vector{openvdb::CoordBBox(c, c)});
                 ++moved;
             }
     EXPECT_GT(moved, 40u);

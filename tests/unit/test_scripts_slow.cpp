@@ -91,6 +91,30 @@ TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
     });
 }
 
+// The mesh a Sculptor keeps up to date, segment by segment from what each segment reports it
+// changed, is after every stroke the mesh of the whole grid: chunk for chunk, normals included.
+TEST_P(DataScript, TheMeshKeptUpToDateIsTheMeshOfTheGrid) {
+    const std::string name = GetParam();
+    const StrokeScript script = readStrokeScript(dataPath(name));
+    Sculptor sculptor(makeStartGrid(script, SWEEPERS_DATA_DIR, voxelSize(script.grid.voxelSize)));
+    sculptor.startMeshing();
+    applyStrokes(sculptor, script.strokes, {}, [&](std::size_t stroke) {
+        SurfaceMesher whole;
+        whole.rebuild(sculptor.grid());
+        const auto& kept = sculptor.mesher().chunks();
+        ASSERT_EQ(kept.size(), whole.chunks().size()) << name << " stroke " << stroke;
+        for (const auto& [origin, chunk] : whole.chunks()) {
+            const auto it = kept.find(origin);
+            ASSERT_NE(it, kept.end()) << name << " stroke " << stroke << " " << origin;
+            ASSERT_EQ(it->second.positions, chunk.positions) << name << " " << origin;
+            ASSERT_EQ(it->second.normals, chunk.normals) << name << " " << origin;
+            ASSERT_EQ(it->second.triangles, chunk.triangles) << name << " " << origin;
+        }
+        std::printf("[ mesh ] %s, stroke %zu: the %zu chunks kept are the grid's\n", name.c_str(),
+                    stroke, kept.size());
+    });
+}
+
 INSTANTIATE_TEST_SUITE_P(Data, DataScript,
                          ::testing::Values("drag", "finger", "horn", "mirrored_ears", "pinch",
                                            "pinch_torus", "pull", "severed_horn", "starfish_swirls",
