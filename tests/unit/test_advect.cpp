@@ -63,6 +63,16 @@ Placement at(const Eigen::Vector3d& t) {
     return p;
 }
 
+// A pinch whose needles start just outside the unit sphere, along y.
+PinchSpec pinchAcrossTheSphere() {
+    PinchSpec spec;
+    spec.axis = Eigen::Vector3d::UnitY();
+    spec.size = 1.1;
+    spec.falloff = 0.3;
+    spec.open = 0.15;
+    return spec;
+}
+
 struct Translated {
     GridPtr grid;
     Eigen::Vector3d d;
@@ -153,12 +163,7 @@ TEST(Advect, TheBandIsWidenedByTheLargestStretch) {
 TEST(Advect, TheBandIsWidenedOnlyWhereTheStretchAsks) {
     const double h = 1.0 / 32;
     GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
-    PinchSpec spec;
-    spec.axis = Eigen::Vector3d::UnitY();
-    spec.size = 1.1;
-    spec.falloff = 0.3;
-    spec.open = 0.15;
-    const auto parts = planPinch(spec, h);
+    const auto parts = planPinch(pinchAcrossTheSphere(), h);
     bool widened = false;
     for (std::size_t j = 0; j + 1 < parts.size() && !widened; ++j) {
         const GridPtr before = g->deepCopy();
@@ -434,12 +439,7 @@ TEST(Advect, ASegmentReportsEveryVoxelItChanged) {
     }
     {
         GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
-        PinchSpec spec;
-        spec.axis = Eigen::Vector3d::UnitY();
-        spec.size = 1.1;
-        spec.falloff = 0.3;
-        spec.open = 0.15;
-        for (const auto& part : planPinch(spec, h))
+        for (const auto& part : planPinch(pinchAcrossTheSphere(), h))
             check("pinch", *g, *part, {});
     }
     {
