@@ -411,7 +411,12 @@ std::size_t SurfaceMesher::update(const Grid& grid,
     // The leaf at o reads its voxels and those from o - 1 to o + 9 along each axis (LeafBlock):
     // a voxel v is read by the leaves with o from v - 9 to v + 1, the multiples of 8 from
     // floor8(v - 2) to floor8(v + 1). In leaf units (o / 8, o >> 3), per box:
-    constexpr int kLog2 = int(LeafNode::LOG2DIM);
+    constexpr int kDim = int(LeafNode::DIM), kLog2 = int(LeafNode::LOG2DIM);
+    // (The origin of a leaf from its place in leaf units: multiplied, since shifting a
+    // negative value left is undefined.)
+    const auto originAt = [&](const openvdb::Coord& c) {
+        return openvdb::Coord(c.x() * kDim, c.y() * kDim, c.z() * kDim);
+    };
     const auto readers = [&](const openvdb::CoordBBox& box) {
         return openvdb::CoordBBox(box.min().offsetBy(-2) >> kLog2, box.max().offsetBy(1) >> kLog2);
     };
@@ -451,13 +456,13 @@ std::size_t SurfaceMesher::update(const Grid& grid,
         for (int x = extent.min().x(); x <= extent.max().x(); ++x)
             for (int y = extent.min().y(); y <= extent.max().y(); ++y)
                 for (int z = extent.min().z(); z <= extent.max().z(); ++z)
-                    if (marked[at(x, y, z)]) origins.push_back(openvdb::Coord(x, y, z) << kLog2);
+                    if (marked[at(x, y, z)]) origins.push_back(originAt(openvdb::Coord(x, y, z)));
     } else {
         for (const openvdb::CoordBBox& box : changed) {
             if (box.empty()) continue;
             const openvdb::CoordBBox r = readers(box);
             for (auto it = r.begin(); it; ++it)
-                origins.push_back(*it << kLog2);
+                origins.push_back(originAt(*it));
         }
         std::sort(origins.begin(), origins.end());
         origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
