@@ -787,10 +787,8 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         // and one step past it, where the band may grow. The sign floods and the pruning of
         // emptied leaves change inactive values only.
         changedBoxes->clear();
-        const int margin = options.renormalize ? 1 : 0;
-        for (const openvdb::MaskTree* mask : {&changed->tree(), &fresh->tree()}) {
-            if (options.renormalize && mask == &fresh->tree()) continue; // within `changed`
-            for (auto it = mask->cbeginLeaf(); it; ++it) {
+        const auto addBoxes = [&](const openvdb::MaskTree& mask, int margin) {
+            for (auto it = mask.cbeginLeaf(); it; ++it) {
                 leafwords::Words on;
                 for (int x = 0; x < 8; ++x)
                     on[std::size_t(x)] = it->getValueMask().getWord<leafwords::Word>(x);
@@ -802,6 +800,12 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                     o.offsetBy(lo[0] - margin, lo[1] - margin, lo[2] - margin),
                     o.offsetBy(hi[0] + margin, hi[1] + margin, hi[2] + margin));
             }
+        };
+        if (options.renormalize) {
+            addBoxes(changed->tree(), 1);
+        } else {
+            addBoxes(changed->tree(), 0);
+            addBoxes(fresh->tree(), 0);
         }
     }
     return stats;

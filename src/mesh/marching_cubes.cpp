@@ -420,15 +420,19 @@ std::size_t SurfaceMesher::update(const Grid& grid,
     const auto readers = [&](const openvdb::CoordBBox& box) {
         return openvdb::CoordBBox(box.min().offsetBy(-2) >> kLog2, box.max().offsetBy(1) >> kLog2);
     };
+    // Per box, the leaves (in leaf units) that read it.
+    std::vector<openvdb::CoordBBox> read;
+    read.reserve(changed.size());
     openvdb::CoordBBox extent;
     std::size_t marks = 0;
     for (const openvdb::CoordBBox& box : changed) {
         if (box.empty()) continue;
-        openvdb::CoordBBox read = box;
-        read.expand(2);
-        changes_.box.expand(read);
-        extent.expand(readers(box));
-        marks += readers(box).volume();
+        openvdb::CoordBBox around = box;
+        around.expand(2);
+        changes_.box.expand(around);
+        read.push_back(readers(box));
+        extent.expand(read.back());
+        marks += read.back().volume();
     }
     // The origins, each once: marked in a dense array over the extent of the boxes, unless the
     // boxes lie so far apart that the array would hold many more entries than marks. (With
@@ -445,25 +449,19 @@ std::size_t SurfaceMesher::update(const Grid& grid,
                        std::size_t(dim.z()) +
                    std::size_t(z - extent.min().z());
         };
-        for (const openvdb::CoordBBox& box : changed) {
-            if (box.empty()) continue;
-            const openvdb::CoordBBox r = readers(box);
+        for (const openvdb::CoordBBox& r : read)
             for (int x = r.min().x(); x <= r.max().x(); ++x)
                 for (int y = r.min().y(); y <= r.max().y(); ++y)
                     for (int z = r.min().z(); z <= r.max().z(); ++z)
                         marked[at(x, y, z)] = 1;
-        }
         for (int x = extent.min().x(); x <= extent.max().x(); ++x)
             for (int y = extent.min().y(); y <= extent.max().y(); ++y)
                 for (int z = extent.min().z(); z <= extent.max().z(); ++z)
                     if (marked[at(x, y, z)]) origins.push_back(originAt(openvdb::Coord(x, y, z)));
     } else {
-        for (const openvdb::CoordBBox& box : changed) {
-            if (box.empty()) continue;
-            const openvdb::CoordBBox r = readers(box);
+        for (const openvdb::CoordBBox& r : read)
             for (auto it = r.begin(); it; ++it)
                 origins.push_back(originAt(*it));
-        }
         std::sort(origins.begin(), origins.end());
         origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
     }
