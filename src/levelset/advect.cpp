@@ -84,6 +84,11 @@ class SampleSource {
             copies.tree().addLeaf(leaf);
     }
 
+    // Frees the copies, when nothing else holds them (freeOnThisThread).
+    void freeCopies() {
+        if (copies_.use_count() == 1) freeOnThisThread(copies_->tree());
+    }
+
     // One per thread. The interface of a tree accessor that OpenVDB's samplers read.
     class Accessor {
       public:
@@ -745,17 +750,20 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                          tornWindow, options.sampling, *changed, options.interrupter, &added);
             sampled = std::move(all);
         }
+        from->freeCopies();
     } else {
         // Each sub-step reads what the one before wrote, inactive values included, so their
         // signs are re-derived before it reads them: otherwise a pre-image beyond the band
         // takes the sign its place had before the earlier sub-steps moved the surface.
         for (int k = 0; k < seg.steps(); ++k) {
             if (k > 0) stats.leavesFlooded += floodSignsIn(grid.tree(), moving, touched);
+            const auto from = source(k);
             stats.sampledVoxels += resample(
-                grid, moving, *source(k), !widened || k > 0, region,
+                grid, moving, *from, !widened || k > 0, region,
                 [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); },
                 seg.tears() ? &seg : nullptr, tornWindow, options.sampling, *changed,
                 options.interrupter);
+            from->freeCopies();
         }
     }
     stats.voxelsVisited += stats.sampledVoxels;
@@ -808,6 +816,11 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             addBoxes(fresh->tree(), 0);
         }
     }
+    // The segment's masks are freed here rather than by their destructors (freeOnThisThread).
+    freeOnThisThread(changed->tree());
+    freeOnThisThread(fresh->tree());
+    for (const openvdb::MaskTree::Ptr& m : marks) // `mask` holds the first of them
+        freeOnThisThread(*m);
     return stats;
 }
 

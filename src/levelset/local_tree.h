@@ -40,6 +40,18 @@ template <typename TreeT> auto leavesIn(TreeT& tree, const openvdb::CoordBBox& b
     return out;
 }
 
+// Frees the nodes of `tree` on the calling thread, leaving it empty. OpenVDB's Tree::clear,
+// which a tree's destructor calls, frees the leaves in a parallel loop, and threads freeing
+// small blocks of one heap at once contend for it: the masks of a drag segment at 1/256
+// (2,000-3,400 leaves) took 0.4-0.7 ms each to free that way.
+template <typename TreeT> void freeOnThisThread(TreeT& tree) {
+    std::vector<typename TreeT::LeafNodeType*> leaves;
+    tree.stealNodes(leaves);
+    for (auto* leaf : leaves)
+        delete leaf;
+    tree.clear();
+}
+
 // Copies the values of `box` into `out`, a dense array indexed ((x * ny) + y) * nz + z
 // from box.min(), a leaf's row at a time: `leafAt(origin)` gives the leaf at that origin (or
 // null), `valueAt(ijk)` the value of a tile or the background where there is none. What

@@ -426,3 +426,19 @@ TEST(LocalTree, LeafSignsAreFloodedAsOpenVdbFloodsThem) {
     }
     EXPECT_GT(changed, 300); // leaves the fill changed: the case tested
 }
+
+// A tree freed on the calling thread is empty and can be used again, and every node it held
+// is freed (the sanitizers' run finds any that is not).
+TEST(LocalTree, ATreeFreedOnThisThreadIsEmpty) {
+    openvdb::MaskTree tree;
+    for (int i = 0; i < 40; ++i)
+        tree.touchLeaf(openvdb::Coord(8 * i, -300 * i, 5000 - 64 * i))->setValueOn(i);
+    tree.addTile(1, openvdb::Coord(4096, 0, 0), true, true); // an active tile, a leaf in size
+    ASSERT_EQ(tree.leafCount(), 40u);
+    freeOnThisThread(tree);
+    EXPECT_EQ(tree.leafCount(), 0u);
+    EXPECT_EQ(tree.activeVoxelCount(), 0u);
+    EXPECT_TRUE(tree.empty());
+    tree.touchLeaf(openvdb::Coord(1, 2, 3))->setValueOn(0);
+    EXPECT_EQ(tree.activeVoxelCount(), 1u);
+}
