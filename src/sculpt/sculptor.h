@@ -25,6 +25,10 @@ struct SegmentReport {
     AdvectStats stats;
     double seconds = 0.0;     // advection, renormalization included
     double meshSeconds = 0.0; // incremental re-meshing of the touched leaves (when meshing)
+    // The advection without renormalization: the band's growth and sampling, and the set-up
+    // and clean-up around them (freeing the segment's masks and copies), which no stage of
+    // AdvectStats times.
+    double advectSeconds() const { return seconds - stats.renormalizeSeconds; }
     std::size_t remeshedLeaves = 0;
     double meshVolume = 0.0; // enclosed volume of the mesh after the segment (applyStrokes,
                              // when meshing: it sums the whole mesh)

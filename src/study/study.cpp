@@ -198,7 +198,7 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
     const std::vector<SegmentReport> reports =
         applyStrokes(sculptor, strokes, progress, {}, &history);
     for (const SegmentReport& r : reports) {
-        row.advectSeconds += r.stats.growSeconds + r.stats.sampleSeconds;
+        row.advectSeconds += r.advectSeconds();
         row.renormSeconds += r.stats.renormalizeSeconds;
     }
     ExactReference reference(startShape);

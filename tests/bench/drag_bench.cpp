@@ -25,7 +25,7 @@ void addSegmentCounters(benchmark::State& state, const std::vector<SegmentReport
     std::vector<double> total, advect, renorm, mesh;
     for (const SegmentReport& r : reports) {
         total.push_back(1e3 * (r.seconds + r.meshSeconds));
-        advect.push_back(1e3 * (r.stats.growSeconds + r.stats.sampleSeconds));
+        advect.push_back(1e3 * r.advectSeconds());
         renorm.push_back(1e3 * r.stats.renormalizeSeconds);
         mesh.push_back(1e3 * r.meshSeconds);
     }
