@@ -696,9 +696,13 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // elsewhere a sample at a voxel centre gives back its own value. A widened band is the
     // exception: its values differ from the grid's, so every leaf is resampled from it.
     const auto movingOf = [&](const std::vector<LeafNode*>& leaves) {
+        std::vector<char> moves(leaves.size(), 1);
+        if (!widened)
+            tbb::parallel_for(std::size_t(0), leaves.size(),
+                              [&](std::size_t l) { moves[l] = !still(*leaves[l]); });
         std::vector<LeafNode*> out;
-        for (LeafNode* leaf : leaves)
-            if (widened || !still(*leaf)) out.push_back(leaf);
+        for (std::size_t l = 0; l < leaves.size(); ++l)
+            if (moves[l]) out.push_back(leaves[l]);
         return out;
     };
     std::vector<LeafNode*> moving = movingOf(sampled);

@@ -9,6 +9,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "levelset/leaf_box.h"
 #include "levelset/leaf_words.h"
 
 namespace sweepers {
@@ -105,34 +106,6 @@ template <int Axis> bool spills(const Bits& b, int dir, int r) {
     return false;
 }
 
-// The leaves of a box, every slot holding the index of its leaf in a list or -1: the
-// neighbour of a leaf is an array read, not a hash lookup.
-class LeafBox {
-  public:
-    LeafBox(const openvdb::Coord& lo, const openvdb::Coord& hi)
-        : lo_(lo), n_(hi - lo + openvdb::Coord(1)),
-          index_(std::size_t(n_.x()) * std::size_t(n_.y()) * std::size_t(n_.z()), -1) {}
-    // The list index of the leaf at position c (-1: none, or outside the box).
-    int& at(const openvdb::Coord& c) { return index_[slot(c)]; }
-    int get(const openvdb::Coord& c) const {
-        const openvdb::Coord d = c - lo_;
-        if (d.x() < 0 || d.y() < 0 || d.z() < 0 || d.x() >= n_.x() || d.y() >= n_.y() ||
-            d.z() >= n_.z())
-            return -1;
-        return index_[slot(c)];
-    }
-
-  private:
-    std::size_t slot(const openvdb::Coord& c) const {
-        const openvdb::Coord d = c - lo_;
-        return (std::size_t(d.x()) * std::size_t(n_.y()) + std::size_t(d.y())) *
-                   std::size_t(n_.z()) +
-               std::size_t(d.z());
-    }
-    openvdb::Coord lo_, n_;
-    std::vector<int> index_;
-};
-
 // One dilation by r (1..8) along Axis of every leaf of the list, the list growing by the
 // neighbours it reaches into. Each leaf's result is read from itself and its two neighbours
 // along the axis, so the leaves are done in parallel.
@@ -164,13 +137,10 @@ template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box,
         leaves[i].bits = out[i];
 }
 
-// A box of leaves may hold this many slots per leaf of the mask (plus a few thousand) before
-// the mask is split: a brush's band fills a few percent of its box.
-constexpr std::size_t kSlotsPerLeaf = 64, kFewSlots = 1 << 15;
-
 // Dilates the leaves of [begin, end) by the cube of half-side `radius` into `tree`. The cube
-// distributes over a union, so a mask whose leaves are far apart is split in two along its
-// longest side, and each half is dilated in its own box.
+// distributes over a union, so a mask whose leaves are far apart (more slots in their box
+// than kSlotsPerLeaf a leaf) is split in two along its longest side, and each half is dilated
+// in its own box.
 void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::iterator end,
                 int radius, openvdb::MaskTree& tree) {
     const int reach = (radius + kDim - 1) / kDim; // in leaves

@@ -17,6 +17,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "levelset/leaf_box.h"
 #include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
 #include "levelset/upwind_row.h"
@@ -52,24 +53,49 @@ class Domain {
         openvdb::CoordBBox outer = region;
         outer.expand(margin);
         leaves_ = leavesIn(grid.tree(), outer);
-        // The leaves by origin, where each leaf's neighbours are looked up (in parallel).
-        std::vector<std::pair<openvdb::Coord, int>> index(leaves_.size());
-        for (std::size_t l = 0; l < leaves_.size(); ++l)
-            index[l] = {leaves_[l]->origin(), int(l)};
-        std::sort(index.begin(), index.end());
         neighbours_.resize(leaves_.size());
-        tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
-            for (int a = 0; a < 3; ++a)
-                for (int d = 0; d < 2; ++d) {
-                    openvdb::Coord o = leaves_[l]->origin();
-                    o[a] += d ? Leaf::DIM : -int(Leaf::DIM);
-                    const auto it = std::lower_bound(
-                        index.begin(), index.end(), o,
-                        [](const auto& entry, const openvdb::Coord& c) { return entry.first < c; });
-                    neighbours_[l][2 * std::size_t(a) + std::size_t(d)] =
-                        it != index.end() && it->first == o ? it->second : -1;
-                }
-        });
+        // The leaves' positions (origins in leaves) and their box.
+        std::vector<openvdb::Coord> at(leaves_.size());
+        openvdb::CoordBBox box;
+        for (std::size_t l = 0; l < leaves_.size(); ++l) {
+            at[l] = leaves_[l]->origin() >> Leaf::LOG2DIM;
+            box.expand(at[l]);
+        }
+        // Each leaf's six neighbours, found by find(position) (-1: none), in parallel.
+        const auto link = [&](const auto& find) {
+            tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+                for (int a = 0; a < 3; ++a)
+                    for (int d = 0; d < 2; ++d) {
+                        openvdb::Coord p = at[l];
+                        p[a] += d ? 1 : -1;
+                        neighbours_[l][2 * std::size_t(a) + std::size_t(d)] = find(p);
+                    }
+            });
+        };
+        // They are looked up in a table of the leaves over their box where a band fills enough
+        // of it (a drag segment's 4,000 leaves at 1/256 lie in a box of 22,000), else (shapes
+        // far apart) in the leaves sorted by position: there a binary search for each
+        // neighbour took 0.8 ms and the sort 0.2 ms more; the positions, the table and the
+        // look-ups take 0.3 ms.
+        const openvdb::Coord dim = box.dim();
+        const double slots = leaves_.empty() ? 0.0 : double(dim.x()) * dim.y() * dim.z();
+        if (slots <= double(kSlotsPerLeaf * leaves_.size() + kFewSlots)) {
+            LeafBox table(box.min(), box.max());
+            for (std::size_t l = 0; l < leaves_.size(); ++l)
+                table.at(at[l]) = int(l);
+            link([&](const openvdb::Coord& p) { return table.get(p); });
+        } else {
+            std::vector<std::pair<openvdb::Coord, int>> sorted(leaves_.size());
+            for (std::size_t l = 0; l < leaves_.size(); ++l)
+                sorted[l] = {at[l], int(l)};
+            std::sort(sorted.begin(), sorted.end());
+            link([&](const openvdb::Coord& p) {
+                const auto it = std::lower_bound(
+                    sorted.begin(), sorted.end(), p,
+                    [](const auto& entry, const openvdb::Coord& c) { return entry.first < c; });
+                return it != sorted.end() && it->first == p ? it->second : -1;
+            });
+        }
     }
 
     std::size_t size() const { return leaves_.size() * kLeafVoxels; }

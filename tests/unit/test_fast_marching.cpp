@@ -273,6 +273,44 @@ TEST(FastMarching, OneThreadAndTwoGiveTheSameBand) {
     }
 }
 
+// A shape far from another (here a copy of it, 4,000 voxels away on every axis) is
+// renormalized as it is alone, to the bit: the band's leaves find their neighbours in a
+// table over their box, and where the box is mostly empty, as here, in a sorted list.
+TEST(FastMarching, AShapeFarFromAnotherIsRenormalizedAsAlone) {
+    const double h = 1.0 / 48;
+    auto sdf = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
+    GridPtr alone = gridFromSdf(sdf, h, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90));
+    distort(*alone);
+    GridPtr pair = alone->deepCopy();
+    const openvdb::Coord away(4000, 4000, 4000); // a whole number of leaves
+    for (auto leaf = alone->tree().cbeginLeaf(); leaf; ++leaf) {
+        auto* copy = new LeafNode(*leaf);
+        copy->setOrigin(leaf->origin() + away);
+        pair->tree().addLeaf(copy);
+    }
+    renormalizeAll(*alone);
+    renormalizeAll(*pair);
+    std::size_t leaves = 0, differ = 0, moved = 0;
+    for (auto leaf = alone->tree().cbeginLeaf(); leaf; ++leaf)
+        for (const openvdb::Coord& at : {leaf->origin(), leaf->origin() + away}) {
+            const LeafNode* other = pair->tree().probeConstLeaf(at);
+            ASSERT_NE(other, nullptr) << at;
+            ++leaves;
+            for (openvdb::Index i = 0; i < LeafNode::SIZE; ++i)
+                differ += leaf->getValue(i) != other->getValue(i) ||
+                          leaf->isValueOn(i) != other->isValueOn(i);
+        }
+    EXPECT_EQ(pair->tree().leafCount(), leaves);
+    EXPECT_EQ(differ, 0u);
+    // The renormalization did change the values: what was compared is its work.
+    GridPtr distorted = gridFromSdf(sdf, h, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90));
+    distort(*distorted);
+    const auto acc = distorted->getConstAccessor();
+    for (auto it = alone->cbeginValueOn(); it; ++it)
+        moved += std::abs(*it - acc.getValue(it.getCoord())) > 0.1 * h;
+    EXPECT_GT(moved, 1000u);
+}
+
 // relaxRow takes four lanes at a time on any CPU and eight at once with AVX2: both give the
 // same values and the same moved lanes, to the bit, with either stencil. (Both halves of a
 // row are solved from the row as it was: a half written before the other was solved would
