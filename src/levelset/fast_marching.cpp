@@ -415,7 +415,7 @@ class Renormalizer {
         return std::uint8_t(axis | (g[first] < 0.0f) << 2 | (g[second] < 0.0f) << 3);
     }
 
-    FmmStats run(const openvdb::CoordBBox& region, Grid& grid) {
+    FmmStats run(Grid& grid) {
         FmmStats stats;
         flagThin();
         stats.seeds = seed();
@@ -423,9 +423,14 @@ class Renormalizer {
         solve();
         pollInterrupt(interrupter_); // the last chance: nothing has been written yet
         stats.marched = writeBack();
-        openvdb::CoordBBox written = region;
-        written.expand(2);
-        pruneEmptyLeavesIn(grid.tree(), written);
+        // Leaves the write-back left without an active voxel become tiles of their sign, one at
+        // a time (the tree changes), from what the write-back saw in parallel.
+        for (std::size_t l = 0; l < b_.leafCount(); ++l) {
+            if (!emptied_[l]) continue;
+            const Leaf& leaf = b_.leaf(l);
+            const float value = leaf.getFirstValue() < 0.0f ? -bg_ : bg_;
+            grid.tree().addTile(1, leaf.origin(), value, false); // frees the leaf
+        }
         stats.leaves = b_.leafCount();
         return stats;
     }
@@ -899,6 +904,7 @@ class Renormalizer {
     //    voxels the solve gave a distance within the band (seeds excluded).
     std::size_t writeBack() {
         tbb::enumerable_thread_specific<std::size_t> solved(0);
+        emptied_.assign(b_.leafCount(), 0);
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             // Only the free voxels, straight into the leaf's buffer and its mask a word at a
             // time (most of a domain is boundary; a setValueOn per voxel checked whether the
@@ -942,6 +948,7 @@ class Renormalizer {
                 n += std::size_t(__builtin_popcountll(band & ~settled_[l][std::size_t(x)]));
             }
             solved.local() += n;
+            emptied_[l] = mask.isOff();
         });
         return solved.combine(std::plus<>());
     }
@@ -967,6 +974,8 @@ class Renormalizer {
     std::vector<Bits> beyond_;
     // Per leaf: how its block is laid out and swept (layoutOf).
     std::vector<std::uint8_t> layout_;
+    // Per leaf: whether the write-back left it without an active voxel.
+    std::vector<char> emptied_;
 };
 
 FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
@@ -974,7 +983,7 @@ FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
     if (region.empty()) return {};
     pollInterrupt(interrupter);
     Renormalizer renormalizer(grid, region, only, order, interrupter);
-    return renormalizer.run(region, grid);
+    return renormalizer.run(grid);
 }
 
 } // namespace

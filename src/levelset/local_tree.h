@@ -3,8 +3,8 @@
 //
 // The leaves overlapping a box are found by descending the tree through the internal
 // nodes that overlap it; signs of inactive values are re-derived (signed flood fill) in the
-// leaves and internal nodes overlapping the box, bottom up; leaves left without an active
-// voxel are replaced by tiles; the values of a box are copied into a dense array.
+// leaves and internal nodes overlapping the box, bottom up; the values of a box are copied
+// into a dense array.
 #pragma once
 
 #include <algorithm>
@@ -202,16 +202,6 @@ inline std::size_t floodSignsIn(Grid::TreeType& tree, const std::vector<LeafNode
     fillAll(uppers);
     fill(tree.root()); // the root's tiles between its (few) children
     return leaves.size();
-}
-
-// Replaces the leaves overlapping `box` that hold no active voxel by tiles of their sign.
-inline void pruneEmptyLeavesIn(Grid::TreeType& tree, const openvdb::CoordBBox& box) {
-    const float background = tree.background();
-    for (LeafNode* leaf : leavesIn(tree, box)) {
-        if (!leaf->isEmpty()) continue;
-        const float value = leaf->getFirstValue() < 0.0f ? -background : background;
-        tree.addTile(1, leaf->origin(), value, false); // level 1: one leaf-sized tile
-    }
 }
 
 } // namespace sweepers

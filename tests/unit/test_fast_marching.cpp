@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 #include <openvdb/tools/LevelSetMeasure.h>
+#include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/SignedFloodFill.h>
 #include <tbb/global_control.h>
 
@@ -270,6 +271,49 @@ TEST(FastMarching, OneThreadAndTwoGiveTheSameBand) {
         }
         EXPECT_EQ(one->tree().leafCount(), two->tree().leafCount());
         EXPECT_EQ(differ, 0u) << "run " << run;
+    }
+}
+
+// A leaf the renormalized band leaves without an active voxel becomes a tile of its sign:
+// here the sphere's surface moves two voxels in (its outer band's leaves fall empty) or out
+// (its inner band's).
+TEST(FastMarching, ALeafLeftWithoutBandBecomesATileOfItsSide) {
+    const double h = 1.0 / 48;
+    auto sdf = [](const Eigen::Vector3d& p) { return p.norm() - 0.8; }; // 38.4 voxels
+    for (const int in : {1, -1}) {
+        GridPtr g = gridFromSdf(sdf, h, 3, openvdb::CoordBBox::createCube({-45, -45, -45}, 90));
+        for (auto it = g->beginValueOn(); it; ++it)
+            it.setValue(*it + float(2 * in * h));
+        // The band grows two voxels towards the new surface, as advection grows it before
+        // renormalizing.
+        openvdb::tools::dilateActiveValues(g->tree(), 2, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                           openvdb::tools::IGNORE_TILES);
+        std::vector<openvdb::Coord> origins;
+        for (auto leaf = g->tree().cbeginLeaf(); leaf; ++leaf)
+            origins.push_back(leaf->origin());
+        openvdb::CoordBBox region = g->evalActiveVoxelBoundingBox();
+        region.expand(2);
+        renormalize(*g, region);
+        std::size_t empty = 0;
+        for (auto leaf = g->tree().cbeginLeaf(); leaf; ++leaf)
+            empty += leaf->isEmpty();
+        EXPECT_EQ(empty, 0u) << in;
+        // The leaves that fell empty are gone, and their tiles hold the side of the new
+        // surface they lie on: outside where it moved in, inside where it moved out.
+        const auto acc = g->getConstAccessor();
+        const float bg = g->background();
+        std::size_t left = 0;
+        for (const openvdb::Coord& o : origins) {
+            if (g->tree().probeConstLeaf(o)) continue;
+            const double r = g->indexToWorld(o.asVec3d() + openvdb::Vec3d(3.5)).length();
+            const bool inside = r < 0.8 - 2 * in * h;
+            EXPECT_EQ(acc.getValue(o), inside ? -bg : bg) << in << " " << o;
+            left += inside == (in < 0);
+        }
+        EXPECT_GT(left, 50u) << in; // leaves on the side the surface left, gone
+        const BandReport band = checkBand(*g);
+        EXPECT_EQ(band.bandHoles, 0u) << in;
+        EXPECT_EQ(band.beyondBand, 0u) << in;
     }
 }
 
