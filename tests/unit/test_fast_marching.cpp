@@ -64,6 +64,22 @@ void distort(Grid& g) {
     }
 }
 
+// A torus at 1/48 whose values distort() scaled: what the renormalization tests solve.
+GridPtr distortedTorus() {
+    auto sdf = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
+    GridPtr g = gridFromSdf(sdf, 1.0 / 48, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90));
+    distort(*g);
+    return g;
+}
+
+// How many voxels of two leaves differ in value or state.
+std::size_t differingVoxels(const LeafNode& a, const LeafNode& b) {
+    std::size_t n = 0;
+    for (openvdb::Index i = 0; i < LeafNode::SIZE; ++i)
+        n += a.getValue(i) != b.getValue(i) || a.isValueOn(i) != b.isValueOn(i);
+    return n;
+}
+
 void renormalizes(const char* name, GridPtr g,
                   const std::function<double(const Eigen::Vector3d&)>& sdf) {
     distort(*g);
@@ -246,10 +262,7 @@ TEST(FastMarching, ThinRodSurvivesManyRenormalizations) {
 // reads its face neighbours' values): the result is then the same on one thread as on two,
 // to the bit, however the threads share the leaves.
 TEST(FastMarching, OneThreadAndTwoGiveTheSameBand) {
-    const double h = 1.0 / 48;
-    auto sdf = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
-    GridPtr g = gridFromSdf(sdf, h, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90));
-    distort(*g);
+    const GridPtr g = distortedTorus();
     GridPtr one = g->deepCopy();
     {
         const tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
@@ -265,9 +278,7 @@ TEST(FastMarching, OneThreadAndTwoGiveTheSameBand) {
         for (auto leaf = one->tree().cbeginLeaf(); leaf; ++leaf) {
             const LeafNode* other = two->tree().probeConstLeaf(leaf->origin());
             ASSERT_NE(other, nullptr) << leaf->origin();
-            for (openvdb::Index i = 0; i < LeafNode::SIZE; ++i)
-                differ += leaf->getValue(i) != other->getValue(i) ||
-                          leaf->isValueOn(i) != other->isValueOn(i);
+            differ += differingVoxels(*leaf, *other);
         }
         EXPECT_EQ(one->tree().leafCount(), two->tree().leafCount());
         EXPECT_EQ(differ, 0u) << "run " << run;
@@ -321,10 +332,7 @@ TEST(FastMarching, ALeafLeftWithoutBandBecomesATileOfItsSide) {
 // renormalized as it is alone, to the bit: the band's leaves find their neighbours in a
 // table over their box, and where the box is mostly empty, as here, in a sorted list.
 TEST(FastMarching, AShapeFarFromAnotherIsRenormalizedAsAlone) {
-    const double h = 1.0 / 48;
-    auto sdf = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
-    GridPtr alone = gridFromSdf(sdf, h, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90));
-    distort(*alone);
+    const GridPtr alone = distortedTorus(), distorted = distortedTorus();
     GridPtr pair = alone->deepCopy();
     const openvdb::Coord away(4000, 4000, 4000); // a whole number of leaves
     for (auto leaf = alone->tree().cbeginLeaf(); leaf; ++leaf) {
@@ -340,18 +348,14 @@ TEST(FastMarching, AShapeFarFromAnotherIsRenormalizedAsAlone) {
             const LeafNode* other = pair->tree().probeConstLeaf(at);
             ASSERT_NE(other, nullptr) << at;
             ++leaves;
-            for (openvdb::Index i = 0; i < LeafNode::SIZE; ++i)
-                differ += leaf->getValue(i) != other->getValue(i) ||
-                          leaf->isValueOn(i) != other->isValueOn(i);
+            differ += differingVoxels(*leaf, *other);
         }
     EXPECT_EQ(pair->tree().leafCount(), leaves);
     EXPECT_EQ(differ, 0u);
     // The renormalization did change the values: what was compared is its work.
-    GridPtr distorted = gridFromSdf(sdf, h, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90));
-    distort(*distorted);
     const auto acc = distorted->getConstAccessor();
     for (auto it = alone->cbeginValueOn(); it; ++it)
-        moved += std::abs(*it - acc.getValue(it.getCoord())) > 0.1 * h;
+        moved += std::abs(*it - acc.getValue(it.getCoord())) > 0.1 / 48;
     EXPECT_GT(moved, 1000u);
 }
 
