@@ -1,7 +1,8 @@
-// A box of leaves, every slot holding the index of a leaf in a list or -1: a leaf's neighbour
-// is an array read, not a search or a hash lookup. Positions are in leaves (origin / 8). The
-// mask dilation and the renormalization's domain find neighbouring leaves this way, where the
-// leaves fill enough of their box.
+// A box of leaves, every slot holding the index of a leaf in a list (or a mark) or -1: a
+// leaf's neighbour is an array read, not a search or a hash lookup. Positions are in leaves
+// (origin / 8). The mask dilation and the renormalization's domain find neighbouring leaves
+// this way, and the mesher marks the leaves to mesh again, where the leaves fill enough of
+// their box.
 #pragma once
 
 #include <cstddef>

@@ -10,6 +10,7 @@
 #include <tbb/parallel_sort.h>
 #include <xxhash.h>
 
+#include "levelset/leaf_box.h"
 #include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
 #include "levelset/stencils.h"
@@ -439,25 +440,14 @@ std::size_t SurfaceMesher::update(const Grid& grid,
     // some 6,000 boxes a drag segment at 1/256, each read by up to 27 leaves, sorting their
     // origins made its meshing 1.6 to 1.8 times as long.)
     std::vector<openvdb::Coord> origins;
-    const openvdb::Coord dim = extent.dim();
     const std::size_t cells = extent.empty() ? 0 : extent.volume();
     if (cells <= 2 * marks + 4096) {
-        std::vector<char> marked(cells, 0);
-        const auto at = [&](int x, int y, int z) {
-            return (std::size_t(x - extent.min().x()) * std::size_t(dim.y()) +
-                    std::size_t(y - extent.min().y())) *
-                       std::size_t(dim.z()) +
-                   std::size_t(z - extent.min().z());
-        };
+        LeafBox marked(extent.min(), extent.max()); // 0 where a leaf reads a box
         for (const openvdb::CoordBBox& r : read)
-            for (int x = r.min().x(); x <= r.max().x(); ++x)
-                for (int y = r.min().y(); y <= r.max().y(); ++y)
-                    for (int z = r.min().z(); z <= r.max().z(); ++z)
-                        marked[at(x, y, z)] = 1;
-        for (int x = extent.min().x(); x <= extent.max().x(); ++x)
-            for (int y = extent.min().y(); y <= extent.max().y(); ++y)
-                for (int z = extent.min().z(); z <= extent.max().z(); ++z)
-                    if (marked[at(x, y, z)]) origins.push_back(originAt(openvdb::Coord(x, y, z)));
+            for (auto it = r.begin(); it; ++it)
+                marked.at(*it) = 0;
+        for (auto it = extent.begin(); it; ++it)
+            if (marked.get(*it) == 0) origins.push_back(originAt(*it));
     } else {
         for (const openvdb::CoordBBox& r : read)
             for (auto it = r.begin(); it; ++it)
