@@ -203,7 +203,8 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 }
 
 // Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
-// map(x), and marks in `changed` the voxels whose value changed. When the source holds the
+// map(x), and lists in `changed` the voxels whose value changed, a leaf at a time (a leaf
+// resampled again is listed again: the caller unites the lists). When the source holds the
 // grid's own values (`sourceIsGrid`: no widened band), a voxel that the map leaves in place
 // keeps its value without interpolating: a sample at a voxel centre returns it exactly.
 // A deformation that tears space (`tearing`) adds how deep x lies in what it opened. A point
@@ -216,10 +217,10 @@ template <typename Map>
 std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const SampleSource& source,
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
                      const StepDeformation* tearing, double tornWindow, Sampling sampling,
-                     openvdb::MaskGrid& changed, Interrupter* interrupter,
+                     VoxelList& changed, Interrupter* interrupter,
                      const openvdb::MaskTree* only = nullptr) {
     // Per leaf, the voxels whose value changed (a word per x, as the leaf's mask holds them):
-    // written by the leaf's own task, then merged into `changed` a leaf at a time.
+    // written by the leaf's own task, then listed.
     std::vector<leafwords::Words> changedWords(leaves.size());
     std::atomic<std::size_t> count{0};
     tbb::enumerable_thread_specific<SourceBlock> blocks;
@@ -284,13 +285,9 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
         }
         count += n;
     });
-    for (std::size_t l = 0; l < leaves.size(); ++l) {
-        const auto& words = changedWords[l];
-        if (!leafwords::any(words)) continue;
-        auto& mask = changed.tree().touchLeaf(leaves[l]->origin())->getValueMask();
-        for (int x = 0; x < 8; ++x)
-            mask.getWord<std::uint64_t>(x) |= words[std::size_t(x)];
-    }
+    for (std::size_t l = 0; l < leaves.size(); ++l)
+        if (leafwords::any(changedWords[l]))
+            changed.push_back({leaves[l]->origin(), changedWords[l]});
     return count;
 }
 
@@ -402,21 +399,39 @@ void makeLeavesWithin(Grid& grid, const openvdb::MaskTree& mask, int beyond,
                 for (int dz = -1; dz <= 1; ++dz)
                     if (near(dy, y) && near(dz, z))
                         across[dy + 1][dz + 1] |= std::uint64_t(1) << (8 * y + z);
-    auto acc = grid.getAccessor();
-    const auto make = [&](const openvdb::Coord& o) {
-        if (box.hasOverlap(openvdb::CoordBBox::createCube(o, 8)) && !acc.probeConstLeaf(o))
-            acc.touchLeaf(o);
-    };
+    // The leaves missing are found in parallel, reading the tree, and made after, on this
+    // thread (the tree changes): most of the up to 27 places a mask leaf reaches hold a leaf
+    // already, and looking them all up on one thread took 0.7-0.8 ms of a drag segment at
+    // 1/256.
+    std::vector<const openvdb::MaskTree::LeafNodeType*> from;
     for (auto it = mask.cbeginLeaf(); it; ++it)
-        for (int dx = -1; dx <= 1; ++dx) {
-            std::uint64_t rows = 0;
-            for (int x = 0; x < 8; ++x)
-                if (near(dx, x)) rows |= it->getValueMask().getWord<std::uint64_t>(x);
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz)
-                    if (rows & across[dy + 1][dz + 1])
-                        make(it->origin().offsetBy(8 * dx, 8 * dy, 8 * dz));
+        from.push_back(&*it);
+    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> missing;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, from.size()), [&](const auto& r) {
+        const auto acc = grid.getConstAccessor();
+        auto& out = missing.local();
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const auto& leaf = *from[i];
+            for (int dx = -1; dx <= 1; ++dx) {
+                std::uint64_t rows = 0;
+                for (int x = 0; x < 8; ++x)
+                    if (near(dx, x)) rows |= leaf.getValueMask().getWord<std::uint64_t>(x);
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dz = -1; dz <= 1; ++dz) {
+                        if (!(rows & across[dy + 1][dz + 1])) continue;
+                        const openvdb::Coord o = leaf.origin().offsetBy(8 * dx, 8 * dy, 8 * dz);
+                        if (box.hasOverlap(openvdb::CoordBBox::createCube(o, 8)) &&
+                            !acc.probeConstLeaf(o))
+                            out.push_back(o);
+                    }
+            }
         }
+    });
+    // (A leaf two mask leaves reach is listed twice: touching it again finds it.)
+    auto acc = grid.getAccessor();
+    for (const auto& list : missing)
+        for (const openvdb::Coord& o : list)
+            acc.touchLeaf(o);
 }
 
 // How many voxels (face steps) the band of each of `leaves` is to be widened by. A stretch s
@@ -650,33 +665,43 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         widened = source;
     }
     // Voxels the band grows into (renormalized, or dropped again, wherever they are): the
-    // mask's voxels not yet on in the grid, found and switched on a leaf and a word at a time.
-    // (Through accessors: the mask's leaves come in the tree's order, so most lie in the
-    // internal node of the one before.)
-    openvdb::MaskGrid::Ptr fresh = openvdb::MaskGrid::create();
-    const auto switchOn = [&](const openvdb::MaskTree& on, openvdb::MaskTree& newly) {
-        auto into = grid.getAccessor();
-        openvdb::tree::ValueAccessor<openvdb::MaskTree, false> freshAcc(newly);
-        for (auto it = on.cbeginLeaf(); it; ++it) {
-            if (it->isEmpty()) continue;
-            auto& on = into.touchLeaf(it->origin())->getValueMask();
-            openvdb::MaskTree::LeafNodeType* grown = nullptr;
-            for (int x = 0; x < 8; ++x) {
-                const std::uint64_t add = it->getValueMask().getWord<std::uint64_t>(x);
-                if (const std::uint64_t newlyOn = add & ~on.getWord<std::uint64_t>(x)) {
-                    if (!grown) grown = freshAcc.touchLeaf(it->origin());
-                    grown->getValueMask().getWord<std::uint64_t>(x) = newlyOn;
-                }
-                on.getWord<std::uint64_t>(x) |= add;
+    // mask's voxels not yet on in the grid. The grid's leaves are found (or made) on this
+    // thread, through an accessor (the mask's leaves come in the tree's order, so most lie in
+    // the internal node of the one before); the voxels are switched on a leaf and a word at a
+    // time in parallel.
+    const auto switchOn = [&](const openvdb::MaskTree& on) {
+        std::vector<const openvdb::MaskTree::LeafNodeType*> from;
+        std::vector<LeafNode*> to;
+        {
+            auto into = grid.getAccessor();
+            for (auto it = on.cbeginLeaf(); it; ++it) {
+                if (it->isEmpty()) continue;
+                from.push_back(&*it);
+                to.push_back(into.touchLeaf(it->origin()));
             }
         }
+        std::vector<leafwords::Words> newlyOn(from.size());
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, from.size()), [&](const auto& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                auto& words = to[i]->getValueMask();
+                for (int x = 0; x < 8; ++x) {
+                    const std::uint64_t add = from[i]->getValueMask().getWord<std::uint64_t>(x);
+                    newlyOn[i][std::size_t(x)] = add & ~words.getWord<std::uint64_t>(x);
+                    words.getWord<std::uint64_t>(x) |= add;
+                }
+            }
+        });
+        VoxelList newly;
+        for (std::size_t i = 0; i < from.size(); ++i)
+            if (leafwords::any(newlyOn[i])) newly.push_back({from[i]->origin(), newlyOn[i]});
+        return newly;
     };
-    switchOn(mask->tree(), fresh->tree());
+    VoxelList fresh = switchOn(mask->tree());
     stats.growSeconds = secondsSince(t0);
 
     // 2. Sample: composed inverse (default) or one resample per sub-step (5.3.4).
     t0 = Clock::now();
-    const openvdb::MaskGrid::Ptr changed = openvdb::MaskGrid::create();
+    VoxelList changed;
     std::vector<LeafNode*> sampled = leavesIn(grid.tree(), region);
     stats.leavesVisited += sampled.size();
     // Leaves the band just grew into, outside the widened copies: sampling writes them, so it
@@ -722,16 +747,17 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         const auto from = source(0);
         stats.sampledVoxels =
             resample(grid, moving, *from, !widened, region, map, seg.tears() ? &seg : nullptr,
-                     tornWindow, options.sampling, *changed, options.interrupter);
+                     tornWindow, options.sampling, changed, options.interrupter);
         if (reach < bandReach && !seedsSampled(grid, moving, region)) {
             // A strong stretch spread the images apart: the images are dilated as far as the
             // band reaches, and the voxels that adds are sampled from the same source (the
             // leaves it adds copied first, while they still hold their tiles' values).
             dilateByCube(mask->tree(), bandReach - reach);
             stats.sampledReach = bandReach;
-            openvdb::MaskTree added;
-            switchOn(mask->tree(), added);
-            uniteMasks(fresh->tree(), added);
+            const VoxelList added = switchOn(mask->tree());
+            fresh = unitedLists(std::move(fresh), added);
+            openvdb::MaskTree addedTree;
+            uniteMasks(addedTree, added);
             std::vector<LeafNode*> all = leavesIn(grid.tree(), region), grown;
             // `sampled` is in the tree's order, and the tree only gained leaves.
             for (std::size_t i = 0, j = 0; i < all.size(); ++i) {
@@ -749,9 +775,11 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                 stats.leavesCopied += movingGrown.size();
             }
             moving.insert(moving.end(), movingGrown.begin(), movingGrown.end());
+            VoxelList more;
             stats.sampledVoxels +=
                 resample(grid, moving, *from, !widened, region, map, seg.tears() ? &seg : nullptr,
-                         tornWindow, options.sampling, *changed, options.interrupter, &added);
+                         tornWindow, options.sampling, more, options.interrupter, &addedTree);
+            changed = unitedLists(std::move(changed), more);
             sampled = std::move(all);
         }
         from->freeCopies();
@@ -762,11 +790,13 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         for (int k = 0; k < seg.steps(); ++k) {
             if (k > 0) stats.leavesFlooded += floodSignsIn(grid.tree(), moving, touched);
             const auto from = source(k);
+            VoxelList more;
             stats.sampledVoxels += resample(
                 grid, moving, *from, !widened || k > 0, region,
                 [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); },
-                seg.tears() ? &seg : nullptr, tornWindow, options.sampling, *changed,
+                seg.tears() ? &seg : nullptr, tornWindow, options.sampling, more,
                 options.interrupter);
+            changed = unitedLists(std::move(changed), more);
             from->freeCopies();
         }
     }
@@ -780,14 +810,16 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
 
     // 3. Renormalize the changed region (and the band around it).
     t0 = Clock::now();
+    // Where renormalization frees voxels: the changed ones dilated, and the fresh ones.
+    openvdb::MaskGrid::Ptr freed = openvdb::MaskGrid::create();
     if (options.renormalize) {
         // Only where values changed, and as far as the band reaches from there (the nearest
         // surface of a voxel nearby may have moved): where the deformation is the identity
         // (outside the tools' coatings, which fill only part of the box) the distances hold.
-        dilateByCube(changed->tree(), int(std::ceil(halfWidth)) + 1);
-        uniteMasks(changed->tree(), fresh->tree());
+        dilateByCube(changed, int(std::ceil(halfWidth)) + 1, freed->tree());
+        uniteMasks(freed->tree(), fresh);
         const FmmStats fmm =
-            renormalize(grid, touched, *changed, options.renormalization, options.interrupter);
+            renormalize(grid, touched, *freed, options.renormalization, options.interrupter);
         stats.leavesVisited += fmm.leaves;
         stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
     }
@@ -795,34 +827,32 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     stats.touched = touched;
     if (changedBoxes) {
         // Sampling changed the band's voxels in `changed` and switched on those of `fresh`;
-        // renormalization, where it ran, wrote within `changed` (grown by then to hold `fresh`)
-        // and one step past it, where the band may grow. The sign floods and the pruning of
-        // emptied leaves change inactive values only.
+        // renormalization, where it ran, wrote within `freed` and one step past it, where the
+        // band may grow. The sign floods and the pruning of emptied leaves change inactive
+        // values only.
         changedBoxes->clear();
-        const auto addBoxes = [&](const openvdb::MaskTree& mask, int margin) {
-            for (auto it = mask.cbeginLeaf(); it; ++it) {
+        const auto addBox = [&](const openvdb::Coord& o, const leafwords::Words& on, int margin) {
+            if (!leafwords::any(on)) return;
+            int lo[3], hi[3];
+            leafwords::bounds(on, lo, hi);
+            changedBoxes->emplace_back(o.offsetBy(lo[0] - margin, lo[1] - margin, lo[2] - margin),
+                                       o.offsetBy(hi[0] + margin, hi[1] + margin, hi[2] + margin));
+        };
+        if (options.renormalize) {
+            for (auto it = freed->tree().cbeginLeaf(); it; ++it) {
                 leafwords::Words on;
                 for (int x = 0; x < 8; ++x)
                     on[std::size_t(x)] = it->getValueMask().getWord<leafwords::Word>(x);
-                if (!leafwords::any(on)) continue;
-                int lo[3], hi[3];
-                leafwords::bounds(on, lo, hi);
-                const openvdb::Coord o = it->origin();
-                changedBoxes->emplace_back(
-                    o.offsetBy(lo[0] - margin, lo[1] - margin, lo[2] - margin),
-                    o.offsetBy(hi[0] + margin, hi[1] + margin, hi[2] + margin));
+                addBox(it->origin(), on, 1);
             }
-        };
-        if (options.renormalize) {
-            addBoxes(changed->tree(), 1);
         } else {
-            addBoxes(changed->tree(), 0);
-            addBoxes(fresh->tree(), 0);
+            for (const VoxelList* list : {&changed, &fresh})
+                for (const LeafVoxels& leaf : *list)
+                    addBox(leaf.origin, leaf.words, 0);
         }
     }
     // The segment's masks are freed here rather than by their destructors (freeOnThisThread).
-    freeOnThisThread(changed->tree());
-    freeOnThisThread(fresh->tree());
+    freeOnThisThread(freed->tree());
     for (const openvdb::MaskTree::Ptr& m : marks) // `mask` holds the first of them
         freeOnThisThread(*m);
     return stats;

@@ -200,6 +200,18 @@ void dilateByCube(openvdb::MaskTree& tree, int radius) {
     if (!leaves.empty()) dilateInto(leaves.begin(), leaves.end(), radius, tree);
 }
 
+void dilateByCube(const VoxelList& from, int radius, openvdb::MaskTree& into) {
+    if (radius < 0) throw std::invalid_argument("dilateByCube: a negative radius");
+    std::vector<MaskLeaf> leaves(from.size());
+    for (std::size_t i = 0; i < from.size(); ++i)
+        leaves[i] = {from[i].origin >> Leaf::LOG2DIM, from[i].words};
+    if (radius == 0) {
+        uniteMasks(into, from);
+        return;
+    }
+    if (!leaves.empty()) dilateInto(leaves.begin(), leaves.end(), radius, into);
+}
+
 void uniteMasks(openvdb::MaskTree& into, const openvdb::MaskTree& from) {
     if (from.hasActiveTiles()) {
         into.topologyUnion(from);
@@ -214,6 +226,32 @@ void uniteMasks(openvdb::MaskTree& into, const openvdb::MaskTree& from) {
         for (int x = 0; x < kDim; ++x)
             words.getWord<Word>(x) |= it->getValueMask().getWord<Word>(x);
     }
+}
+
+void uniteMasks(openvdb::MaskTree& into, const VoxelList& from) {
+    openvdb::tree::ValueAccessor<openvdb::MaskTree, false> acc(into);
+    for (const LeafVoxels& leaf : from) {
+        if (!leafwords::any(leaf.words)) continue;
+        auto& words = acc.touchLeaf(leaf.origin)->getValueMask();
+        for (int x = 0; x < kDim; ++x)
+            words.getWord<Word>(x) |= leaf.words[std::size_t(x)];
+    }
+}
+
+VoxelList unitedLists(VoxelList a, const VoxelList& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    std::sort(a.begin(), a.end(),
+              [](const LeafVoxels& p, const LeafVoxels& q) { return p.origin < q.origin; });
+    VoxelList out;
+    for (const LeafVoxels& leaf : a) {
+        if (!out.empty() && out.back().origin == leaf.origin) {
+            for (std::size_t x = 0; x < leaf.words.size(); ++x)
+                out.back().words[x] |= leaf.words[x];
+            continue;
+        }
+        out.push_back(leaf);
+    }
+    return out;
 }
 
 } // namespace sweepers

@@ -97,3 +97,61 @@ TEST(UniteMasks, EqualsOpenVdbTopologyUnion) {
     EXPECT_TRUE(into->isValueOn(openvdb::Coord(-60, 3, 5)));
     EXPECT_EQ(into->activeVoxelCount(), expected->activeVoxelCount());
 }
+
+namespace {
+
+// The mask as a list of its leaves' words.
+VoxelList listOf(const openvdb::MaskTree& tree) {
+    VoxelList out;
+    for (auto it = tree.cbeginLeaf(); it; ++it) {
+        LeafVoxels leaf{it->origin(), {}};
+        for (int x = 0; x < 8; ++x)
+            leaf.words[std::size_t(x)] = it->getValueMask().getWord<leafwords::Word>(x);
+        out.push_back(leaf);
+    }
+    return out;
+}
+
+} // namespace
+
+// A list dilated into an empty tree gives the tree dilated, and into a tree holding other
+// voxels, their union.
+TEST(DilateByCube, AListDilatesAsItsTreeDoes) {
+    for (int radius : {0, 1, 4, 9}) {
+        const auto mask = randomMask(21), other = randomMask(22);
+        auto expected = std::make_shared<openvdb::MaskTree>(*mask);
+        dilateByCube(*expected, radius);
+        openvdb::MaskTree into;
+        dilateByCube(listOf(*mask), radius, into);
+        EXPECT_EQ(into.activeVoxelCount(), expected->activeVoxelCount()) << radius;
+        EXPECT_TRUE(into.hasSameTopology(*expected)) << radius;
+        openvdb::MaskTree both(*other);
+        dilateByCube(listOf(*mask), radius, both);
+        expected->topologyUnion(*other);
+        EXPECT_TRUE(both.hasSameTopology(*expected)) << radius;
+    }
+}
+
+TEST(UniteMasks, AListAddsItsVoxels) {
+    const auto into = randomMask(31), from = randomMask(32);
+    auto expected = std::make_shared<openvdb::MaskTree>(*into);
+    expected->topologyUnion(*from);
+    uniteMasks(*into, listOf(*from));
+    EXPECT_EQ(into->activeVoxelCount(), expected->activeVoxelCount());
+    EXPECT_TRUE(into->hasSameTopology(*expected));
+}
+
+// Two lists sharing some leaves: their union holds every voxel of both, each leaf once.
+TEST(UniteMasks, UnitedListsHoldEachLeafOnce) {
+    const auto a = randomMask(41), b = randomMask(42);
+    const VoxelList united = unitedLists(listOf(*a), listOf(*b));
+    auto expected = std::make_shared<openvdb::MaskTree>(*a);
+    expected->topologyUnion(*b);
+    EXPECT_EQ(united.size(), expected->leafCount());
+    for (std::size_t i = 1; i < united.size(); ++i)
+        EXPECT_LT(united[i - 1].origin, united[i].origin);
+    openvdb::MaskTree tree;
+    uniteMasks(tree, united);
+    EXPECT_TRUE(tree.hasSameTopology(*expected));
+    EXPECT_EQ(tree.activeVoxelCount(), expected->activeVoxelCount());
+}
