@@ -204,7 +204,7 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 
 // Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
 // map(x), and lists in `changed` the voxels whose value changed, a leaf at a time (a leaf
-// resampled again is listed again: the caller unites the lists). When the source holds the
+// resampled again is listed again). When the source holds the
 // grid's own values (`sourceIsGrid`: no widened band), a voxel that the map leaves in place
 // keeps its value without interpolating: a sample at a voxel centre returns it exactly.
 // A deformation that tears space (`tearing`) adds how deep x lies in what it opened. A point
@@ -755,7 +755,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             dilateByCube(mask->tree(), bandReach - reach);
             stats.sampledReach = bandReach;
             const VoxelList added = switchOn(mask->tree());
-            fresh = unitedLists(std::move(fresh), added);
+            fresh.insert(fresh.end(), added.begin(), added.end());
             openvdb::MaskTree addedTree;
             uniteMasks(addedTree, added);
             std::vector<LeafNode*> all = leavesIn(grid.tree(), region), grown;
@@ -775,11 +775,9 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                 stats.leavesCopied += movingGrown.size();
             }
             moving.insert(moving.end(), movingGrown.begin(), movingGrown.end());
-            VoxelList more;
             stats.sampledVoxels +=
                 resample(grid, moving, *from, !widened, region, map, seg.tears() ? &seg : nullptr,
-                         tornWindow, options.sampling, more, options.interrupter, &addedTree);
-            changed = unitedLists(std::move(changed), more);
+                         tornWindow, options.sampling, changed, options.interrupter, &addedTree);
             sampled = std::move(all);
         }
         from->freeCopies();
@@ -790,13 +788,11 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         for (int k = 0; k < seg.steps(); ++k) {
             if (k > 0) stats.leavesFlooded += floodSignsIn(grid.tree(), moving, touched);
             const auto from = source(k);
-            VoxelList more;
             stats.sampledVoxels += resample(
                 grid, moving, *from, !widened || k > 0, region,
                 [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); },
-                seg.tears() ? &seg : nullptr, tornWindow, options.sampling, more,
+                seg.tears() ? &seg : nullptr, tornWindow, options.sampling, changed,
                 options.interrupter);
-            changed = unitedLists(std::move(changed), more);
             from->freeCopies();
         }
     }
@@ -811,15 +807,15 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // 3. Renormalize the changed region (and the band around it).
     t0 = Clock::now();
     // Where renormalization frees voxels: the changed ones dilated, and the fresh ones.
-    openvdb::MaskGrid::Ptr freed = openvdb::MaskGrid::create();
+    VoxelList freed;
     if (options.renormalize) {
         // Only where values changed, and as far as the band reaches from there (the nearest
         // surface of a voxel nearby may have moved): where the deformation is the identity
         // (outside the tools' coatings, which fill only part of the box) the distances hold.
-        dilateByCube(changed, int(std::ceil(halfWidth)) + 1, freed->tree());
-        uniteMasks(freed->tree(), fresh);
+        freed = dilatedByCube(changed, int(std::ceil(halfWidth)) + 1);
+        freed.insert(freed.end(), fresh.begin(), fresh.end());
         const FmmStats fmm =
-            renormalize(grid, touched, *freed, options.renormalization, options.interrupter);
+            renormalize(grid, touched, freed, options.renormalization, options.interrupter);
         stats.leavesVisited += fmm.leaves;
         stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
     }
@@ -839,12 +835,8 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                                        o.offsetBy(hi[0] + margin, hi[1] + margin, hi[2] + margin));
         };
         if (options.renormalize) {
-            for (auto it = freed->tree().cbeginLeaf(); it; ++it) {
-                leafwords::Words on;
-                for (int x = 0; x < 8; ++x)
-                    on[std::size_t(x)] = it->getValueMask().getWord<leafwords::Word>(x);
-                addBox(it->origin(), on, 1);
-            }
+            for (const LeafVoxels& leaf : freed)
+                addBox(leaf.origin, leaf.words, 1);
         } else {
             for (const VoxelList* list : {&changed, &fresh})
                 for (const LeafVoxels& leaf : *list)
@@ -852,7 +844,6 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         }
     }
     // The segment's masks are freed here rather than by their destructors (freeOnThisThread).
-    freeOnThisThread(freed->tree());
     for (const openvdb::MaskTree::Ptr& m : marks) // `mask` holds the first of them
         freeOnThisThread(*m);
     return stats;

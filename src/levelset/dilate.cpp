@@ -137,12 +137,13 @@ template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box,
         leaves[i].bits = out[i];
 }
 
-// Dilates the leaves of [begin, end) by the cube of half-side `radius` into `tree`. The cube
+// Dilates the leaves of [begin, end) by the cube of half-side `radius`, onto the end of
+// `out`. The cube
 // distributes over a union, so a mask whose leaves are far apart (more slots in their box
 // than kSlotsPerLeaf a leaf) is split in two along its longest side, and each half is dilated
 // in its own box.
 void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::iterator end,
-                int radius, openvdb::MaskTree& tree) {
+                int radius, VoxelList& out) {
     const int reach = (radius + kDim - 1) / kDim; // in leaves
     openvdb::Coord lo = begin->at, hi = begin->at;
     for (auto it = begin; it != end; ++it) {
@@ -160,14 +161,24 @@ void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
         std::nth_element(begin, middle, end, [axis](const MaskLeaf& a, const MaskLeaf& b) {
             return a.at[axis] < b.at[axis];
         });
-        dilateInto(begin, middle, radius, tree);
-        dilateInto(middle, end, radius, tree);
+        dilateInto(begin, middle, radius, out);
+        dilateInto(middle, end, radius, out);
         return;
     }
     std::vector<MaskLeaf> leaves(begin, end);
     LeafBox box(lo, hi);
-    for (std::size_t i = 0; i < leaves.size(); ++i)
-        box.at(leaves[i].at) = int(i);
+    for (std::size_t i = 0; i < leaves.size(); ++i) {
+        // A leaf listed again joins its first entry; the one left empty only gathers what
+        // its neighbours spill into it, as the first entry does.
+        int& slot = box.at(leaves[i].at);
+        if (slot < 0) {
+            slot = int(i);
+            continue;
+        }
+        for (std::size_t x = 0; x < kDim; ++x)
+            leaves[std::size_t(slot)].bits[x] |= leaves[i].bits[x];
+        leaves[i].bits = Bits{};
+    }
     // Cubes add up: past a leaf's width, dilate one leaf's width at a time.
     for (int left = radius; left > 0; left -= kDim) {
         const int r = std::min(left, kDim);
@@ -175,13 +186,10 @@ void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
         dilateList<1>(leaves, box, r);
         dilateList<0>(leaves, box, r);
     }
-    for (const MaskLeaf& leaf : leaves) {
+    for (const MaskLeaf& leaf : leaves)
         // (Multiplied, not shifted: a left shift of a negative coordinate is undefined.)
-        Leaf* node = tree.touchLeaf(
-            openvdb::Coord(leaf.at.x() * kDim, leaf.at.y() * kDim, leaf.at.z() * kDim));
-        for (int x = 0; x < kDim; ++x)
-            node->getValueMask().getWord<Word>(x) |= leaf.bits[std::size_t(x)];
-    }
+        out.push_back({openvdb::Coord(leaf.at.x() * kDim, leaf.at.y() * kDim, leaf.at.z() * kDim),
+                       leaf.bits});
 }
 
 } // namespace
@@ -189,27 +197,26 @@ void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
 void dilateByCube(openvdb::MaskTree& tree, int radius) {
     if (radius < 0) throw std::invalid_argument("dilateByCube: a negative radius");
     if (radius == 0) return;
-    std::vector<MaskLeaf> leaves;
+    VoxelList leaves;
     leaves.reserve(tree.leafCount());
     for (auto it = tree.cbeginLeaf(); it; ++it) {
-        MaskLeaf leaf{it->origin() >> Leaf::LOG2DIM, Bits{}};
+        LeafVoxels leaf{it->origin(), {}};
         for (int x = 0; x < kDim; ++x)
-            leaf.bits[std::size_t(x)] = it->getValueMask().getWord<Word>(x);
+            leaf.words[std::size_t(x)] = it->getValueMask().getWord<Word>(x);
         leaves.push_back(leaf);
     }
-    if (!leaves.empty()) dilateInto(leaves.begin(), leaves.end(), radius, tree);
+    uniteMasks(tree, dilatedByCube(leaves, radius));
 }
 
-void dilateByCube(const VoxelList& from, int radius, openvdb::MaskTree& into) {
+VoxelList dilatedByCube(const VoxelList& from, int radius) {
     if (radius < 0) throw std::invalid_argument("dilateByCube: a negative radius");
+    if (radius == 0) return from;
     std::vector<MaskLeaf> leaves(from.size());
     for (std::size_t i = 0; i < from.size(); ++i)
         leaves[i] = {from[i].origin >> Leaf::LOG2DIM, from[i].words};
-    if (radius == 0) {
-        uniteMasks(into, from);
-        return;
-    }
-    if (!leaves.empty()) dilateInto(leaves.begin(), leaves.end(), radius, into);
+    VoxelList out;
+    if (!leaves.empty()) dilateInto(leaves.begin(), leaves.end(), radius, out);
+    return out;
 }
 
 void uniteMasks(openvdb::MaskTree& into, const openvdb::MaskTree& from) {
@@ -236,22 +243,6 @@ void uniteMasks(openvdb::MaskTree& into, const VoxelList& from) {
         for (int x = 0; x < kDim; ++x)
             words.getWord<Word>(x) |= leaf.words[std::size_t(x)];
     }
-}
-
-VoxelList unitedLists(VoxelList a, const VoxelList& b) {
-    a.insert(a.end(), b.begin(), b.end());
-    std::sort(a.begin(), a.end(),
-              [](const LeafVoxels& p, const LeafVoxels& q) { return p.origin < q.origin; });
-    VoxelList out;
-    for (const LeafVoxels& leaf : a) {
-        if (!out.empty() && out.back().origin == leaf.origin) {
-            for (std::size_t x = 0; x < leaf.words.size(); ++x)
-                out.back().words[x] |= leaf.words[x];
-            continue;
-        }
-        out.push_back(leaf);
-    }
-    return out;
 }
 
 } // namespace sweepers

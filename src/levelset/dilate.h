@@ -11,28 +11,17 @@
 // they are dilated in parallel.
 #pragma once
 
-#include <vector>
-
 #include <openvdb/openvdb.h>
 
-#include "levelset/leaf_words.h"
+#include "levelset/voxel_list.h"
 
 namespace sweepers {
-
-// A voxel set listed leaf by leaf, each leaf at most once: its origin and its voxels as
-// words (leafwords). A segment's working sets are kept so where they are only read a leaf
-// at a time: as a tree, each of their thousands of leaves was made and freed on its own.
-struct LeafVoxels {
-    openvdb::Coord origin;
-    leafwords::Words words;
-};
-using VoxelList = std::vector<LeafVoxels>;
 
 // Dilates the active voxels of the leaves of `tree` by the cube of half-side `radius`
 // (radius >= 0). Active tiles are left as they are.
 void dilateByCube(openvdb::MaskTree& tree, int radius);
-// Adds to `into` the voxels of the list dilated by the cube of half-side `radius`.
-void dilateByCube(const VoxelList& from, int radius, openvdb::MaskTree& into);
+// The voxels of the list dilated by the cube of half-side `radius`.
+VoxelList dilatedByCube(const VoxelList& from, int radius);
 
 // Adds the active voxels of `from` to `into`: the active voxels of into.topologyUnion(from),
 // a leaf of `from` at a time. OpenVDB's union works through the internal nodes' tables:
@@ -42,7 +31,5 @@ void dilateByCube(const VoxelList& from, int radius, openvdb::MaskTree& into);
 void uniteMasks(openvdb::MaskTree& into, const openvdb::MaskTree& from);
 // Adds the voxels of the list to `into`.
 void uniteMasks(openvdb::MaskTree& into, const VoxelList& from);
-// The union of two lists, each leaf once (in the order of their origins).
-VoxelList unitedLists(VoxelList a, const VoxelList& b);
 
 } // namespace sweepers

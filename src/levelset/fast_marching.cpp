@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <type_traits>
 #include <vector>
 
@@ -80,23 +81,20 @@ class Domain {
         const openvdb::Coord dim = box.dim();
         const double slots = leaves_.empty() ? 0.0 : double(dim.x()) * dim.y() * dim.z();
         if (slots <= double(kSlotsPerLeaf * leaves_.size() + kFewSlots)) {
-            LeafBox table(box.min(), box.max());
+            table_.emplace(box.min(), box.max());
             for (std::size_t l = 0; l < leaves_.size(); ++l)
-                table.at(at[l]) = int(l);
-            link([&](const openvdb::Coord& p) { return table.get(p); });
+                table_->at(at[l]) = int(l);
         } else {
-            std::vector<std::pair<openvdb::Coord, int>> sorted(leaves_.size());
+            sorted_.resize(leaves_.size());
             for (std::size_t l = 0; l < leaves_.size(); ++l)
-                sorted[l] = {at[l], int(l)};
-            std::sort(sorted.begin(), sorted.end());
-            link([&](const openvdb::Coord& p) {
-                const auto it = std::lower_bound(
-                    sorted.begin(), sorted.end(), p,
-                    [](const auto& entry, const openvdb::Coord& c) { return entry.first < c; });
-                return it != sorted.end() && it->first == p ? it->second : -1;
-            });
+                sorted_[l] = {at[l], int(l)};
+            std::sort(sorted_.begin(), sorted_.end());
         }
+        link([&](const openvdb::Coord& p) { return find(p); });
     }
+
+    // The index of the leaf at `origin`, or -1 where the domain has none.
+    int indexOf(const openvdb::Coord& origin) const { return find(origin >> Leaf::LOG2DIM); }
 
     std::size_t size() const { return leaves_.size() * kLeafVoxels; }
     std::size_t leafCount() const { return leaves_.size(); }
@@ -147,8 +145,20 @@ class Domain {
     int neighbourLeaf(std::size_t l, int k) const { return neighbours_[l][std::size_t(k)]; }
 
   private:
+    // The index of the leaf at position p (in leaves), or -1.
+    int find(const openvdb::Coord& p) const {
+        if (table_) return table_->get(p);
+        const auto it = std::lower_bound(
+            sorted_.begin(), sorted_.end(), p,
+            [](const auto& entry, const openvdb::Coord& c) { return entry.first < c; });
+        return it != sorted_.end() && it->first == p ? it->second : -1;
+    }
+
     std::vector<Leaf*> leaves_;
     std::vector<std::array<int, 6>> neighbours_;
+    // The leaves by position: a table over their box, or (far apart) sorted.
+    std::optional<LeafBox> table_;
+    std::vector<std::pair<openvdb::Coord, int>> sorted_;
 };
 
 using Bits = Domain::Bits;
@@ -335,7 +345,7 @@ constexpr int kMostSweeps = 32, kMostRounds = 100;
 
 class Renormalizer {
   public:
-    Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid* only,
+    Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
                  FmmOrder order, Interrupter* interrupter)
         : b_(grid, region, 2), n_(b_.size()), h_(float(grid.voxelSize()[0])),
           bg_(grid.background()), order_(order), interrupter_(interrupter),
@@ -344,6 +354,14 @@ class Renormalizer {
           settled_(b_.leafCount(), Bits{}), beyond_(b_.leafCount(), Bits{}),
           layout_(b_.leafCount(), 2) {
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
+        std::vector<Bits> within; // per leaf, the voxels of `only`
+        if (only) {
+            within.resize(b_.leafCount());
+            for (const LeafVoxels& leaf : *only) {
+                const int l = b_.indexOf(leaf.origin);
+                if (l >= 0) within[std::size_t(l)] = within[std::size_t(l)] | leaf.words;
+            }
+        }
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);
             // The leaves' values are read where they are: nothing writes them before the
@@ -360,11 +378,7 @@ class Renormalizer {
             for (std::size_t x = 0; x < 8; ++x)
                 neg_[l][x] = leafwords::negatives(phi + 64 * x, 64);
             Bits free = leafwords::inBox(region, leaf.origin());
-            if (only) {
-                const auto* mask = only->tree().probeConstLeaf(leaf.origin());
-                for (std::size_t x = 0; x < 8; ++x)
-                    free[x] &= mask ? mask->getValueMask().getWord<std::uint64_t>(x) : 0;
-            }
+            if (only) free = free & within[l];
             fixed_[l] = ~free;
         });
         // The band may have to grow past the free voxels: an inactive voxel next to one is
@@ -978,8 +992,8 @@ class Renormalizer {
     std::vector<char> emptied_;
 };
 
-FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region,
-                          const openvdb::MaskGrid* only, FmmOrder order, Interrupter* interrupter) {
+FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
+                          FmmOrder order, Interrupter* interrupter) {
     if (region.empty()) return {};
     pollInterrupt(interrupter);
     Renormalizer renormalizer(grid, region, only, order, interrupter);
@@ -993,7 +1007,7 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder orde
     return renormalizeWhere(grid, region, nullptr, order, interrupter);
 }
 
-FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid& only,
+FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      FmmOrder order, Interrupter* interrupter) {
     return renormalizeWhere(grid, region, &only, order, interrupter);
 }

@@ -26,6 +26,7 @@
 
 #include "levelset/interrupt.h"
 #include "levelset/vdb.h"
+#include "levelset/voxel_list.h"
 
 namespace sweepers {
 
@@ -43,9 +44,9 @@ struct FmmStats {
 // renormalization throws Cancelled before it writes anything back.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region,
                      FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
-// The same, for the voxels of `region` that are also on in `only` (what a deformation
-// changed, grown by the band): the rest keep their values and act as boundary.
-FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const openvdb::MaskGrid& only,
+// The same, for the voxels of `region` that are also in `only` (what a deformation changed,
+// grown by the band): the rest keep their values and act as boundary.
+FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
 
 // Renormalizes the whole active band.

@@ -348,6 +348,44 @@ TEST(FastMarching, AShapeFarFromAnotherIsRenormalizedAsAlone) {
     EXPECT_GT(moved, 1000u);
 }
 
+// With `only`, the voxels it lists are renormalized and the others keep their values; a leaf
+// listed twice, its voxels split between the entries, is renormalized as when listed once.
+TEST(FastMarching, OnlyTheListedVoxelsAreRenormalized) {
+    const GridPtr distorted = distortedTorus();
+    VoxelList once, twice; // the active voxels of the leaves with x < 0
+    for (auto leaf = distorted->tree().cbeginLeaf(); leaf; ++leaf) {
+        if (leaf->origin().x() >= 0) continue;
+        LeafVoxels entry{leaf->origin(), {}};
+        for (int x = 0; x < 8; ++x)
+            entry.words[std::size_t(x)] = leaf->getValueMask().getWord<leafwords::Word>(x);
+        once.push_back(entry);
+        LeafVoxels low = entry, high = entry;
+        for (std::size_t x = 0; x < 8; ++x)
+            (x < 4 ? high : low).words[x] = 0;
+        twice.push_back(low);
+        twice.push_back(high);
+    }
+    openvdb::CoordBBox region = distorted->evalActiveVoxelBoundingBox();
+    region.expand(2);
+    GridPtr a = distorted->deepCopy(), b = distorted->deepCopy();
+    renormalize(*a, region, once);
+    renormalize(*b, region, twice);
+    EXPECT_EQ(sweepers::test::differingVoxels(*a, *b), 0u);
+    const auto before = distorted->getConstAccessor();
+    std::size_t kept = 0, moved = 0;
+    for (auto it = a->cbeginValueOn(); it; ++it) {
+        const float was = before.getValue(it.getCoord());
+        if (it.getCoord().x() >= 0 && before.isValueOn(it.getCoord())) {
+            EXPECT_EQ(*it, was) << it.getCoord();
+            ++kept;
+        } else if (it.getCoord().x() < -2) {
+            moved += std::abs(*it - was) > 0.1 / 48;
+        }
+    }
+    EXPECT_GT(kept, 10000u);
+    EXPECT_GT(moved, 1000u);
+}
+
 // relaxRow takes four lanes at a time on any CPU and eight at once with AVX2: both give the
 // same values and the same moved lanes, to the bit, with either stencil. (Both halves of a
 // row are solved from the row as it was: a half written before the other was solved would

@@ -1,0 +1,21 @@
+// A voxel set listed leaf by leaf: each leaf's origin and its voxels as words (leafwords). A
+// leaf may be listed more than once: its voxels are those of all its entries. A segment's
+// working sets are kept so, where they are only read a leaf at a time: as trees, each of
+// their thousands of leaves was made and freed on its own.
+#pragma once
+
+#include <vector>
+
+#include <openvdb/math/Coord.h>
+
+#include "levelset/leaf_words.h"
+
+namespace sweepers {
+
+struct LeafVoxels {
+    openvdb::Coord origin;
+    leafwords::Words words;
+};
+using VoxelList = std::vector<LeafVoxels>;
+
+} // namespace sweepers
