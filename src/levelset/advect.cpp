@@ -291,16 +291,16 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     return count;
 }
 
-// Marks in `mask` what a tearing deformation needs sampled beyond the band grown around the
-// images of the surface: the inside voxels of the opened region (their sign changes), and
-// the voxels near the opening's rim whose value will lie within `shell` of the surface.
-// Where the surface touched the torn set, the rim is new surface, and the images of the few
-// voxels near the touching point only reach it in their own directions; around the rim the
-// tear stretches space along it by (d + r) / d at distance d from the torn set, and past a
-// stretch of 7 (d < r / 6, less than r / 6 beyond the rim) the images of neighbouring
-// voxels land farther apart than the band's dilation closes.
+// Adds to `mask` (each leaf once) what a tearing deformation needs sampled beyond the band grown
+// around the images of the surface: the inside voxels of the opened region (their sign changes),
+// and the voxels near the opening's rim whose value will lie within `shell` of the surface. Where
+// the surface touched the torn set, the rim is new surface, and the images of the few voxels near
+// the touching point only reach it in their own directions; around the rim the tear stretches space
+// along it by (d + r) / d at distance d from the torn set, and past a stretch of 7 (d < r / 6, less
+// than r / 6 beyond the rim) the images of neighbouring voxels land farther apart than the band's
+// dilation closes.
 std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shell,
-                       openvdb::MaskGrid& mask) {
+                       VoxelList& mask) {
     const double beyond = shell + seg.opening() / 6.0; // how far past the rim to look
     const openvdb::CoordBBox box = indexBox(grid, seg.openedBox().expanded(beyond), 1);
     if (box.empty()) return 0;
@@ -329,12 +329,16 @@ std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shel
                 }
     });
     std::size_t count = 0;
-    auto macc = mask.getAccessor();
+    openvdb::MaskTree opened;
+    openvdb::tree::ValueAccessor<openvdb::MaskTree, false> macc(opened);
     for (const auto& f : found) {
         for (const openvdb::Coord& c : f)
             macc.setValueOn(c);
         count += f.size();
     }
+    const VoxelList listed = listLeaves(opened);
+    mask.insert(mask.end(), listed.begin(), listed.end());
+    mask = eachLeafOnce(std::move(mask)); // switching the band on wants each leaf once
     return count;
 }
 
@@ -387,7 +391,7 @@ bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
 // leaf next to it along an axis when it lies within `beyond` of it (a leaf more would only
 // widen renormalization's domain). Along x the words themselves are chosen; along y and z,
 // the bits of a word.
-void makeLeavesWithin(Grid& grid, const openvdb::MaskTree& mask, int beyond,
+void makeLeavesWithin(Grid& grid, const VoxelList& mask, int beyond,
                       const openvdb::CoordBBox& box) {
     const auto near = [&](int d, int c) {
         return d < 0 ? c < beyond : d > 0 ? c >= 8 - beyond : true;
@@ -403,23 +407,20 @@ void makeLeavesWithin(Grid& grid, const openvdb::MaskTree& mask, int beyond,
     // thread (the tree changes): most of the up to 27 places a mask leaf reaches hold a leaf
     // already, and looking them all up on one thread took 0.7-0.8 ms of a drag segment at
     // 1/256.
-    std::vector<const openvdb::MaskTree::LeafNodeType*> from;
-    for (auto it = mask.cbeginLeaf(); it; ++it)
-        from.push_back(&*it);
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> missing;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, from.size()), [&](const auto& r) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mask.size()), [&](const auto& r) {
         const auto acc = grid.getConstAccessor();
         auto& out = missing.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const auto& leaf = *from[i];
+            const LeafVoxels& leaf = mask[i];
             for (int dx = -1; dx <= 1; ++dx) {
                 std::uint64_t rows = 0;
                 for (int x = 0; x < 8; ++x)
-                    if (near(dx, x)) rows |= leaf.getValueMask().getWord<std::uint64_t>(x);
+                    if (near(dx, x)) rows |= leaf.words[std::size_t(x)];
                 for (int dy = -1; dy <= 1; ++dy)
                     for (int dz = -1; dz <= 1; ++dz) {
                         if (!(rows & across[dy + 1][dz + 1])) continue;
-                        const openvdb::Coord o = leaf.origin().offsetBy(8 * dx, 8 * dy, 8 * dz);
+                        const openvdb::Coord o = leaf.origin.offsetBy(8 * dx, 8 * dy, 8 * dz);
                         if (box.hasOverlap(openvdb::CoordBBox::createCube(o, 8)) &&
                             !acc.probeConstLeaf(o))
                             out.push_back(o);
@@ -427,7 +428,7 @@ void makeLeavesWithin(Grid& grid, const openvdb::MaskTree& mask, int beyond,
             }
         }
     });
-    // (A leaf two mask leaves reach is listed twice: touching it again finds it.)
+    // (A leaf two mask entries reach is listed twice: touching it again finds it.)
     auto acc = grid.getAccessor();
     for (const auto& list : missing)
         for (const openvdb::Coord& o : list)
@@ -600,15 +601,11 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             stretchAt[i / kStretchSampling] = std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
         }
     });
-    openvdb::MaskGrid::Ptr mask = openvdb::MaskGrid::create();
-    mask->setTransform(grid.transform().copy());
-    bool first = true;
+    // The images, listed from each thread's marks (a leaf two threads marked, twice).
+    VoxelList images;
     for (const openvdb::MaskTree::Ptr& m : marks) {
-        if (first)
-            mask->setTree(m);
-        else
-            uniteMasks(mask->tree(), *m);
-        first = false;
+        const VoxelList listed = listLeaves(*m);
+        images.insert(images.end(), listed.begin(), listed.end());
     }
     // The band the images are dilated into, sampled: what renormalization's seeds read (the
     // voxels next to the new crossing and their face neighbours) lies within kSeedReach of
@@ -618,12 +615,12 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // by the whole band did, read about twice as many voxels as the band holds.
     const int bandReach = int(std::ceil(halfWidth)) + 1;
     const int reach = options.resampleEachSubStep ? bandReach : std::min(kSeedReach, bandReach);
-    dilateByCube(mask->tree(), reach);
+    VoxelList mask = dilatedByCube(images, reach);
     stats.sampledReach = reach;
     // A tear opens empty space where there was material: no image of the surface reaches
     // the middle of the opening, so the inside voxels there join the band to be sampled
     // (renormalization drops them again, with their new sign).
-    if (seg.tears()) stats.tornVoxels = markOpened(grid, seg, (halfWidth + 2) * h, *mask);
+    if (seg.tears()) stats.tornVoxels = markOpened(grid, seg, (halfWidth + 2) * h, mask);
     if (measureStretch)
         stats.stretchSamples = (interface.size() + kStretchSampling - 1) / kStretchSampling;
     const double needed = neededFor(*std::max_element(stretchAt.begin(), stretchAt.end()));
@@ -668,16 +665,16 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // mask's voxels not yet on in the grid. The grid's leaves are found (or made) on this
     // thread, through an accessor (the mask's leaves come in the tree's order, so most lie in
     // the internal node of the one before); the voxels are switched on a leaf and a word at a
-    // time in parallel.
-    const auto switchOn = [&](const openvdb::MaskTree& on) {
-        std::vector<const openvdb::MaskTree::LeafNodeType*> from;
+    // time in parallel (the mask lists each leaf once, so no two tasks write one leaf).
+    const auto switchOn = [&](const VoxelList& on) {
+        std::vector<const LeafVoxels*> from;
         std::vector<LeafNode*> to;
         {
             auto into = grid.getAccessor();
-            for (auto it = on.cbeginLeaf(); it; ++it) {
-                if (it->isEmpty()) continue;
-                from.push_back(&*it);
-                to.push_back(into.touchLeaf(it->origin()));
+            for (const LeafVoxels& leaf : on) {
+                if (!leafwords::any(leaf.words)) continue;
+                from.push_back(&leaf);
+                to.push_back(into.touchLeaf(leaf.origin));
             }
         }
         std::vector<leafwords::Words> newlyOn(from.size());
@@ -685,7 +682,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             for (std::size_t i = r.begin(); i != r.end(); ++i) {
                 auto& words = to[i]->getValueMask();
                 for (int x = 0; x < 8; ++x) {
-                    const std::uint64_t add = from[i]->getValueMask().getWord<std::uint64_t>(x);
+                    const std::uint64_t add = from[i]->words[std::size_t(x)];
                     newlyOn[i][std::size_t(x)] = add & ~words.getWord<std::uint64_t>(x);
                     words.getWord<std::uint64_t>(x) |= add;
                 }
@@ -693,10 +690,10 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         });
         VoxelList newly;
         for (std::size_t i = 0; i < from.size(); ++i)
-            if (leafwords::any(newlyOn[i])) newly.push_back({from[i]->origin(), newlyOn[i]});
+            if (leafwords::any(newlyOn[i])) newly.push_back({from[i]->origin, newlyOn[i]});
         return newly;
     };
-    VoxelList fresh = switchOn(mask->tree());
+    VoxelList fresh = switchOn(mask);
     stats.growSeconds = secondsSince(t0);
 
     // 2. Sample: composed inverse (default) or one resample per sub-step (5.3.4).
@@ -752,9 +749,9 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             // A strong stretch spread the images apart: the images are dilated as far as the
             // band reaches, and the voxels that adds are sampled from the same source (the
             // leaves it adds copied first, while they still hold their tiles' values).
-            dilateByCube(mask->tree(), bandReach - reach);
+            mask = dilatedByCube(mask, bandReach - reach);
             stats.sampledReach = bandReach;
-            const VoxelList added = switchOn(mask->tree());
+            const VoxelList added = switchOn(mask);
             fresh.insert(fresh.end(), added.begin(), added.end());
             openvdb::MaskTree addedTree;
             uniteMasks(addedTree, added);
@@ -801,7 +798,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     // The band's outer voxels may lie in leaves no sample reached: those leaves are made now,
     // after the signs were re-derived, so that they take the sign of the tile they replace.
     if (stats.sampledReach < bandReach)
-        makeLeavesWithin(grid, mask->tree(), bandReach - stats.sampledReach, touched);
+        makeLeavesWithin(grid, mask, bandReach - stats.sampledReach, touched);
     stats.sampleSeconds = secondsSince(t0);
 
     // 3. Renormalize the changed region (and the band around it).
@@ -844,7 +841,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         }
     }
     // The segment's masks are freed here rather than by their destructors (freeOnThisThread).
-    for (const openvdb::MaskTree::Ptr& m : marks) // `mask` holds the first of them
+    for (const openvdb::MaskTree::Ptr& m : marks)
         freeOnThisThread(*m);
     return stats;
 }

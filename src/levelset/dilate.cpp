@@ -138,11 +138,12 @@ template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box,
 }
 
 // Dilates the leaves of [begin, end) by the cube of half-side `radius`, onto the end of
-// `out`. The cube
+// `out`, each leaf once unless the set was split (then a leaf both parts reach is listed
+// twice): returns whether it was. The cube
 // distributes over a union, so a mask whose leaves are far apart (more slots in their box
 // than kSlotsPerLeaf a leaf) is split in two along its longest side, and each half is dilated
 // in its own box.
-void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::iterator end,
+bool dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::iterator end,
                 int radius, VoxelList& out) {
     const int reach = (radius + kDim - 1) / kDim; // in leaves
     openvdb::Coord lo = begin->at, hi = begin->at;
@@ -163,21 +164,21 @@ void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
         });
         dilateInto(begin, middle, radius, out);
         dilateInto(middle, end, radius, out);
-        return;
+        return true;
     }
-    std::vector<MaskLeaf> leaves(begin, end);
+    // Each leaf once: one listed again joins its first entry.
+    std::vector<MaskLeaf> leaves;
+    leaves.reserve(count);
     LeafBox box(lo, hi);
-    for (std::size_t i = 0; i < leaves.size(); ++i) {
-        // A leaf listed again joins its first entry; the one left empty only gathers what
-        // its neighbours spill into it, as the first entry does.
-        int& slot = box.at(leaves[i].at);
+    for (auto it = begin; it != end; ++it) {
+        int& slot = box.at(it->at);
         if (slot < 0) {
-            slot = int(i);
+            slot = int(leaves.size());
+            leaves.push_back(*it);
             continue;
         }
         for (std::size_t x = 0; x < kDim; ++x)
-            leaves[std::size_t(slot)].bits[x] |= leaves[i].bits[x];
-        leaves[i].bits = Bits{};
+            leaves[std::size_t(slot)].bits[x] |= it->bits[x];
     }
     // Cubes add up: past a leaf's width, dilate one leaf's width at a time.
     for (int left = radius; left > 0; left -= kDim) {
@@ -190,49 +191,48 @@ void dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
         // (Multiplied, not shifted: a left shift of a negative coordinate is undefined.)
         out.push_back({openvdb::Coord(leaf.at.x() * kDim, leaf.at.y() * kDim, leaf.at.z() * kDim),
                        leaf.bits});
+    return false;
 }
 
 } // namespace
 
-void dilateByCube(openvdb::MaskTree& tree, int radius) {
-    if (radius < 0) throw std::invalid_argument("dilateByCube: a negative radius");
-    if (radius == 0) return;
-    VoxelList leaves;
-    leaves.reserve(tree.leafCount());
-    for (auto it = tree.cbeginLeaf(); it; ++it) {
-        LeafVoxels leaf{it->origin(), {}};
-        for (int x = 0; x < kDim; ++x)
-            leaf.words[std::size_t(x)] = it->getValueMask().getWord<Word>(x);
-        leaves.push_back(leaf);
-    }
-    uniteMasks(tree, dilatedByCube(leaves, radius));
-}
-
 VoxelList dilatedByCube(const VoxelList& from, int radius) {
     if (radius < 0) throw std::invalid_argument("dilateByCube: a negative radius");
-    if (radius == 0) return from;
+    if (radius == 0) return eachLeafOnce(from);
     std::vector<MaskLeaf> leaves(from.size());
     for (std::size_t i = 0; i < from.size(); ++i)
         leaves[i] = {from[i].origin >> Leaf::LOG2DIM, from[i].words};
     VoxelList out;
-    if (!leaves.empty()) dilateInto(leaves.begin(), leaves.end(), radius, out);
+    if (!leaves.empty() && dilateInto(leaves.begin(), leaves.end(), radius, out))
+        out = eachLeafOnce(std::move(out));
     return out;
 }
 
-void uniteMasks(openvdb::MaskTree& into, const openvdb::MaskTree& from) {
-    if (from.hasActiveTiles()) {
-        into.topologyUnion(from);
-        return;
+VoxelList eachLeafOnce(VoxelList list) {
+    std::sort(list.begin(), list.end(),
+              [](const LeafVoxels& p, const LeafVoxels& q) { return p.origin < q.origin; });
+    VoxelList out;
+    for (const LeafVoxels& leaf : list) {
+        if (!out.empty() && out.back().origin == leaf.origin) {
+            for (std::size_t x = 0; x < kDim; ++x)
+                out.back().words[x] |= leaf.words[x];
+            continue;
+        }
+        out.push_back(leaf);
     }
-    // Through an accessor: the leaves come in the tree's order, so most lie in the internal
-    // node of the one before.
-    openvdb::tree::ValueAccessor<openvdb::MaskTree, false> acc(into);
-    for (auto it = from.cbeginLeaf(); it; ++it) {
-        if (it->isEmpty()) continue;
-        auto& words = acc.touchLeaf(it->origin())->getValueMask();
+    return out;
+}
+
+VoxelList listLeaves(const openvdb::MaskTree& tree) {
+    VoxelList out;
+    out.reserve(tree.leafCount());
+    for (auto it = tree.cbeginLeaf(); it; ++it) {
+        LeafVoxels leaf{it->origin(), {}};
         for (int x = 0; x < kDim; ++x)
-            words.getWord<Word>(x) |= it->getValueMask().getWord<Word>(x);
+            leaf.words[std::size_t(x)] = it->getValueMask().getWord<Word>(x);
+        out.push_back(leaf);
     }
+    return out;
 }
 
 void uniteMasks(openvdb::MaskTree& into, const VoxelList& from) {

@@ -1,12 +1,12 @@
-// The voxel masks of a segment's work, a leaf's words at a time: dilation by a cube, and
-// union.
+// The voxel sets of a segment's work, listed leaf by leaf (VoxelList): dilation by a cube,
+// and what turns a tree into such a list and a list into a tree.
 //
-// Dilation by a cube: every voxel within `radius` steps along each axis of an active one
-// becomes active (what `radius` rounds of 26-neighbour dilation give).
+// Dilation by a cube: every voxel within `radius` steps along each axis of one in the set
+// joins it (what `radius` rounds of 26-neighbour dilation give).
 //
-// A sculpting segment dilates two brush-sized masks by the band's half-width. The cube is
+// A sculpting segment dilates two brush-sized sets by the band's reach. The cube is
 // separable, so it is done as three one-dimensional dilations on the 64-bit words of the
-// leaf masks, rather than `radius` rounds over all 26 neighbours. The leaves are indexed by
+// leaves, rather than `radius` rounds over all 26 neighbours. The leaves are indexed by
 // their place in a box of leaves, so each one reads its neighbours by an array lookup, and
 // they are dilated in parallel.
 #pragma once
@@ -17,19 +17,14 @@
 
 namespace sweepers {
 
-// Dilates the active voxels of the leaves of `tree` by the cube of half-side `radius`
-// (radius >= 0). Active tiles are left as they are.
-void dilateByCube(openvdb::MaskTree& tree, int radius);
-// The voxels of the list dilated by the cube of half-side `radius`.
+// The voxels of the list dilated by the cube of half-side `radius` (>= 0), each leaf once.
 VoxelList dilatedByCube(const VoxelList& from, int radius);
 
-// Adds the active voxels of `from` to `into`: the active voxels of into.topologyUnion(from),
-// a leaf of `from` at a time. OpenVDB's union works through the internal nodes' tables:
-// adding a segment's new band to its changed voxels (the drag at 1/128) took 2.75M
-// instructions that way and takes 0.14M this way. A mask with active tiles takes
-// OpenVDB's union.
-void uniteMasks(openvdb::MaskTree& into, const openvdb::MaskTree& from);
-// Adds the voxels of the list to `into`.
+// The active voxels of a tree's leaves (not its tiles), listed in its order.
+VoxelList listLeaves(const openvdb::MaskTree& tree);
+// Adds the voxels of the list to `into`, a leaf at a time.
 void uniteMasks(openvdb::MaskTree& into, const VoxelList& from);
+// The same voxels, each leaf listed once (in the order of their origins).
+VoxelList eachLeafOnce(VoxelList list);
 
 } // namespace sweepers
