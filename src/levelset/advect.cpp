@@ -204,9 +204,9 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 
 // Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
 // map(x), and lists in `changed` the voxels whose value changed, a leaf at a time (a leaf
-// resampled again is listed again). When the source holds the
-// grid's own values (`sourceIsGrid`: no widened band), a voxel that the map leaves in place
-// keeps its value without interpolating: a sample at a voxel centre returns it exactly.
+// resampled again is listed again). When the source holds the grid's own values
+// (`sourceIsGrid`: no widened band), a voxel that the map leaves in place keeps its value
+// without interpolating: a sample at a voxel centre returns it exactly.
 // A deformation that tears space (`tearing`) adds how deep x lies in what it opened. A point
 // it opened reads the largest value along the torn set within `tornWindow` of the point it
 // was torn from: on a grid, what the pinch's needles bring together (or the strangle's noose
@@ -291,14 +291,14 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     return count;
 }
 
-// Adds to `mask` (each leaf once) what a tearing deformation needs sampled beyond the band grown
-// around the images of the surface: the inside voxels of the opened region (their sign changes),
-// and the voxels near the opening's rim whose value will lie within `shell` of the surface. Where
-// the surface touched the torn set, the rim is new surface, and the images of the few voxels near
-// the touching point only reach it in their own directions; around the rim the tear stretches space
-// along it by (d + r) / d at distance d from the torn set, and past a stretch of 7 (d < r / 6, less
-// than r / 6 beyond the rim) the images of neighbouring voxels land farther apart than the band's
-// dilation closes.
+// Adds to `mask` (each leaf once) what a tearing deformation needs sampled beyond the band
+// grown around the images of the surface: the inside voxels of the opened region (their sign
+// changes), and the voxels near the opening's rim whose value will lie within `shell` of the
+// surface. Where the surface touched the torn set, the rim is new surface, and the images of
+// the few voxels near the touching point only reach it in their own directions; around the
+// rim the tear stretches space along it by (d + r) / d at distance d from the torn set, and
+// past a stretch of 7 (d < r / 6, less than r / 6 beyond the rim) the images of neighbouring
+// voxels land farther apart than the band's dilation closes.
 std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shell,
                        VoxelList& mask) {
     const double beyond = shell + seg.opening() / 6.0; // how far past the rim to look
@@ -405,8 +405,8 @@ void makeLeavesWithin(Grid& grid, const VoxelList& mask, int beyond,
                         across[dy + 1][dz + 1] |= std::uint64_t(1) << (8 * y + z);
     // The leaves missing are found in parallel, reading the tree, and made after, on this
     // thread (the tree changes): most of the up to 27 places a mask leaf reaches hold a leaf
-    // already, and looking them all up on one thread took 0.7-0.8 ms of a drag segment at
-    // 1/256.
+    // already, and looking them all up on one thread took 0.66 to 0.85 ms of a drag segment
+    // at 1/256.
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> missing;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mask.size()), [&](const auto& r) {
         const auto acc = grid.getConstAccessor();
@@ -663,9 +663,9 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     }
     // Voxels the band grows into (renormalized, or dropped again, wherever they are): the
     // mask's voxels not yet on in the grid. The grid's leaves are found (or made) on this
-    // thread, through an accessor (the mask's leaves come in the tree's order, so most lie in
-    // the internal node of the one before); the voxels are switched on a leaf and a word at a
-    // time in parallel (the mask lists each leaf once, so no two tasks write one leaf).
+    // thread, through an accessor (entries next to each other in the list mostly lie in one
+    // internal node); the voxels are switched on a leaf and a word at a time in parallel (the
+    // mask lists each leaf once, so no two tasks write one leaf).
     const auto switchOn = [&](const VoxelList& on) {
         std::vector<const LeafVoxels*> from;
         std::vector<LeafNode*> to;

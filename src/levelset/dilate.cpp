@@ -138,11 +138,10 @@ template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box,
 }
 
 // Dilates the leaves of [begin, end) by the cube of half-side `radius`, onto the end of
-// `out`, each leaf once unless the set was split (then a leaf both parts reach is listed
-// twice): returns whether it was. The cube
-// distributes over a union, so a mask whose leaves are far apart (more slots in their box
-// than kSlotsPerLeaf a leaf) is split in two along its longest side, and each half is dilated
-// in its own box.
+// `out`. The cube distributes over a union, so a set whose leaves are far apart (more slots
+// in their box than kSlotsPerLeaf a leaf) is split in two along its longest side, and each
+// half is dilated in its own box. Returns whether it was split: each leaf is listed once
+// unless it was (a leaf both halves reach is listed by both).
 bool dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::iterator end,
                 int radius, VoxelList& out) {
     const int reach = (radius + kDim - 1) / kDim; // in leaves
