@@ -62,20 +62,9 @@ class Domain {
             at[l] = leaves_[l]->origin() >> Leaf::LOG2DIM;
             box.expand(at[l]);
         }
-        // Each leaf's six neighbours, found by find(position) (-1: none), in parallel.
-        const auto link = [&](const auto& find) {
-            tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
-                for (int a = 0; a < 3; ++a)
-                    for (int d = 0; d < 2; ++d) {
-                        openvdb::Coord p = at[l];
-                        p[a] += d ? 1 : -1;
-                        neighbours_[l][2 * std::size_t(a) + std::size_t(d)] = find(p);
-                    }
-            });
-        };
-        // They are looked up in a table of the leaves over their box where a band fills enough
-        // of it (a drag segment's 4,000 leaves at 1/256 lie in a box of 22,000), else (shapes
-        // far apart) in the leaves sorted by position: there a binary search for each
+        // The leaves are found by position in a table over their box where a band fills
+        // enough of it (a drag segment's 4,000 leaves at 1/256 lie in a box of 22,000), else
+        // (shapes far apart) in the leaves sorted by position: there a binary search for each
         // neighbour took 0.8 ms and the sort 0.2 ms more; the positions, the table and the
         // look-ups take 0.3 ms.
         const openvdb::Coord dim = box.dim();
@@ -90,7 +79,15 @@ class Domain {
                 sorted_[l] = {at[l], int(l)};
             std::sort(sorted_.begin(), sorted_.end());
         }
-        link([&](const openvdb::Coord& p) { return find(p); });
+        // Each leaf's six neighbours (-1: none), in parallel.
+        tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+            for (int a = 0; a < 3; ++a)
+                for (int d = 0; d < 2; ++d) {
+                    openvdb::Coord p = at[l];
+                    p[a] += d ? 1 : -1;
+                    neighbours_[l][2 * std::size_t(a) + std::size_t(d)] = find(p);
+                }
+        });
     }
 
     // The index of the leaf at `origin`, or -1 where the domain has none.

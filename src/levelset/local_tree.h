@@ -49,8 +49,9 @@ template <typename TreeT> auto leavesIn(TreeT& tree, const openvdb::CoordBBox& b
 
 // Frees the nodes of `tree` on the calling thread, leaving it empty. OpenVDB's Tree::clear,
 // which a tree's destructor calls, frees the leaves in a parallel loop, and threads freeing
-// small blocks of one heap at once contend for it: the masks of a drag segment at 1/256
-// (2,000-3,400 leaves) took 0.4-0.7 ms each to free that way.
+// small blocks of one heap at once contend for it: mask trees of 2,000-3,400 leaves, as a
+// drag segment at 1/256 made, took 0.4-0.7 ms each to free that way. A segment frees its
+// copies and its threads' marks so.
 template <typename TreeT> void freeOnThisThread(TreeT& tree) {
     std::vector<typename TreeT::LeafNodeType*> leaves;
     tree.stealNodes(leaves);
