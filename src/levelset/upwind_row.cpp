@@ -189,9 +189,13 @@ bool hasAvx2() {
 
 } // namespace detail
 
+RowRelaxer rowRelaxer() {
+    static const RowRelaxer best = detail::hasAvx2() ? detail::relaxRowIn8s : detail::relaxRowIn4s;
+    return best;
+}
+
 unsigned relaxRow(const RowBlock& block, int b, unsigned lanes) {
-    static const bool eight = detail::hasAvx2();
-    return eight ? detail::relaxRowIn8s(block, b, lanes) : detail::relaxRowIn4s(block, b, lanes);
+    return rowRelaxer()(block, b, lanes);
 }
 
 } // namespace sweepers::upwind
