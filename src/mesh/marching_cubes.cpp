@@ -340,22 +340,30 @@ std::size_t SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvd
                                       Interrupter* interrupter) {
     // Each leaf into the chunk it has (its storage reused) or into a new one, which joins
     // the map only when it holds a triangle (a map's elements stay where they are, so the
-    // chunks are written in parallel); chunks left without a triangle go.
+    // chunks are written in parallel); chunks left without a triangle go. The chunks are
+    // looked up in the parallel loop too (nothing changes the map meanwhile): on one thread
+    // the look-ups took some 0.6 ms of a drag segment's meshing at 1/256.
     std::vector<MeshChunk*> into(origins.size());
     std::vector<MeshChunk> fresh(origins.size());
-    for (std::size_t i = 0; i < origins.size(); ++i) {
-        const auto it = chunks_.find(origins[i]);
-        into[i] = it == chunks_.end() ? &fresh[i] : &it->second;
-    }
     std::atomic<std::size_t> meshed{0};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
         pollInterrupt(interrupter);
         std::size_t n = 0;
-        for (std::size_t i = r.begin(); i != r.end(); ++i)
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const auto it = chunks_.find(origins[i]); // (find counts as const for races)
+            if (it != chunks_.end()) {
+                into[i] = &it->second;
+            } else if (grid.tree().probeConstLeaf(origins[i])) {
+                into[i] = &fresh[i];
+            } else {
+                continue; // neither a leaf nor a chunk: nothing to mesh or to empty
+            }
             n += meshLeaf(grid, origins[i], *into[i]);
+        }
         meshed += n;
     });
     for (std::size_t i = 0; i < origins.size(); ++i) {
+        if (!into[i]) continue;
         if (into[i] == &fresh[i]) {
             if (!fresh[i].triangles.empty()) chunks_.emplace(origins[i], std::move(fresh[i]));
         } else if (into[i]->triangles.empty()) {
@@ -455,13 +463,7 @@ std::size_t SurfaceMesher::update(const Grid& grid,
         std::sort(origins.begin(), origins.end());
         origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
     }
-    // Leaves gone since keep their origins here, so that their chunks are emptied.
-    const auto& tree = grid.tree();
-    origins.erase(std::remove_if(origins.begin(), origins.end(),
-                                 [&](const openvdb::Coord& o) {
-                                     return !tree.probeConstLeaf(o) && !chunks_.count(o);
-                                 }),
-                  origins.end());
+    // (Leaves gone since keep their origins here, so that their chunks are emptied.)
     return meshLeaves(grid, origins);
 }
 
