@@ -45,40 +45,45 @@ template <typename Body> void forEachAxis(Body&& body) {
 // The voxels of every leaf overlapping the region (grown by a margin), stored leaf by
 // leaf with each leaf's six face neighbours, so a neighbour is an add or one table
 // lookup. The band lives in leaves; voxels outside them (tiles) are far from the
-// surface and are not needed.
+// surface and are not needed. Given the leaves whose voxels may be freed (`near`), only
+// those and the leaves around them (face, edge or corner) are taken: everything a free
+// voxel's seed, stencils and thin test read lies there (a drag segment's box at 1/256 holds
+// some 4,000 leaves of band, of which a sixth lie farther from any).
 class Domain {
   public:
     static constexpr std::size_t npos = std::numeric_limits<std::size_t>::max();
 
-    Domain(Grid& grid, const openvdb::CoordBBox& region, int margin) {
+    Domain(Grid& grid, const openvdb::CoordBBox& region, int margin, const VoxelList* near) {
         openvdb::CoordBBox outer = region;
         outer.expand(margin);
         leaves_ = leavesIn(grid.tree(), outer);
-        neighbours_.resize(leaves_.size());
-        // The leaves' positions (origins in leaves) and their box.
+        // The leaves' positions (origins in leaves).
         std::vector<openvdb::Coord> at(leaves_.size());
-        openvdb::CoordBBox box;
-        for (std::size_t l = 0; l < leaves_.size(); ++l) {
+        for (std::size_t l = 0; l < leaves_.size(); ++l)
             at[l] = leaves_[l]->origin() >> Leaf::LOG2DIM;
-            box.expand(at[l]);
-        }
-        // The leaves are found by position in a table over their box where a band fills
-        // enough of it (a drag segment's 4,000 leaves at 1/256 lie in a box of 22,000), else
-        // (shapes far apart) in the leaves sorted by position: there a binary search for each
-        // neighbour took 0.8 ms and the sort 0.2 ms more; the positions, the table and the
-        // look-ups take 0.3 ms.
-        const openvdb::Coord dim = box.dim();
-        const double slots = leaves_.empty() ? 0.0 : double(dim.x()) * dim.y() * dim.z();
-        if (slots <= double(kSlotsPerLeaf * leaves_.size() + kFewSlots)) {
-            table_.emplace(box.min(), box.max());
+        index(at);
+        if (near) {
+            std::vector<char> listed(leaves_.size(), 0), kept(leaves_.size(), 0);
+            for (const LeafVoxels& leaf : *near)
+                if (const int l = indexOf(leaf.origin); l >= 0) listed[std::size_t(l)] = 1;
+            tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+                for (int dx = -1; dx <= 1 && !kept[l]; ++dx)
+                    for (int dy = -1; dy <= 1; ++dy)
+                        for (int dz = -1; dz <= 1; ++dz)
+                            if (const int k = find(at[l].offsetBy(dx, dy, dz)); k >= 0)
+                                kept[l] |= listed[std::size_t(k)];
+            });
+            std::size_t n = 0;
             for (std::size_t l = 0; l < leaves_.size(); ++l)
-                table_->at(at[l]) = int(l);
-        } else {
-            sorted_.resize(leaves_.size());
-            for (std::size_t l = 0; l < leaves_.size(); ++l)
-                sorted_[l] = {at[l], int(l)};
-            std::sort(sorted_.begin(), sorted_.end());
+                if (kept[l]) {
+                    leaves_[n] = leaves_[l];
+                    at[n++] = at[l];
+                }
+            leaves_.resize(n);
+            at.resize(n);
+            index(at);
         }
+        neighbours_.resize(leaves_.size());
         // Each leaf's six neighbours (-1: none), in parallel.
         tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
             for (int a = 0; a < 3; ++a)
@@ -142,6 +147,32 @@ class Domain {
     int neighbourLeaf(std::size_t l, int k) const { return neighbours_[l][std::size_t(k)]; }
 
   private:
+    // Finds the leaves (at positions `at`, in leaves) by position: in a table over their box
+    // where a band fills enough of it (a drag segment's 4,000 leaves at 1/256 lie in a box of
+    // 22,000), else (shapes far apart) in the leaves sorted by position: there a binary
+    // search for each neighbour took 0.8 ms and the sort 0.2 ms more; the positions, the
+    // table and the look-ups take 0.3 ms.
+    void index(const std::vector<openvdb::Coord>& at) {
+        table_.reset();
+        sorted_.clear();
+        if (at.empty()) return;
+        openvdb::CoordBBox box;
+        for (const openvdb::Coord& p : at)
+            box.expand(p);
+        const openvdb::Coord dim = box.dim();
+        const double slots = double(dim.x()) * dim.y() * dim.z();
+        if (slots <= double(kSlotsPerLeaf * at.size() + kFewSlots)) {
+            table_.emplace(box.min(), box.max());
+            for (std::size_t l = 0; l < at.size(); ++l)
+                table_->at(at[l]) = int(l);
+        } else {
+            sorted_.resize(at.size());
+            for (std::size_t l = 0; l < at.size(); ++l)
+                sorted_[l] = {at[l], int(l)};
+            std::sort(sorted_.begin(), sorted_.end());
+        }
+    }
+
     // The index of the leaf at position p (in leaves), or -1.
     int find(const openvdb::Coord& p) const {
         if (table_) return table_->get(p);
@@ -344,7 +375,7 @@ class Renormalizer {
   public:
     Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
                  FmmOrder order, Interrupter* interrupter)
-        : b_(grid, region, 2), n_(b_.size()), h_(float(grid.voxelSize()[0])),
+        : b_(grid, region, 2, only), n_(b_.size()), h_(float(grid.voxelSize()[0])),
           bg_(grid.background()), order_(order), interrupter_(interrupter),
           phi_(b_.leafCount(), nullptr), dist_(new float[n_]), thin_(b_.leafCount(), Bits{}),
           neg_(b_.leafCount(), Bits{}), fixed_(b_.leafCount(), Bits{}),

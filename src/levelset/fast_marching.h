@@ -35,7 +35,9 @@ enum class FmmOrder { First = 1, Second = 2 };
 struct FmmStats {
     std::size_t seeds = 0;
     std::size_t marched = 0; // voxels given a distance within the band (seeds excluded)
-    std::size_t leaves = 0;  // leaves of the domain (overlapping the region and its margin)
+    // Leaves of the domain: those overlapping the region and its margin (given `only`, those
+    // of them holding or next to a leaf it lists).
+    std::size_t leaves = 0;
 };
 
 // Recomputes the distances of the voxels inside `region` (index space). The result is a
@@ -45,7 +47,8 @@ struct FmmStats {
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region,
                      FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
 // The same, for the voxels of `region` that are also in `only` (what a deformation changed,
-// grown by the band): the rest keep their values and act as boundary.
+// grown by the band): the rest keep their values and act as boundary. The work is that of
+// the leaves `only` lists and those next to them, however many more the region holds.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
 

@@ -386,6 +386,60 @@ TEST(FastMarching, OnlyTheListedVoxelsAreRenormalized) {
     EXPECT_GT(moved, 1000u);
 }
 
+// Given the voxels it may free, renormalization takes the leaves holding them and those around
+// them (face, edge or corner) as its domain, not every leaf of the region: a shape elsewhere
+// in the region adds no leaf to it, and the listed shape's values come out the same.
+TEST(FastMarching, TheDomainIsTheLeavesAroundTheListedOnes) {
+    const GridPtr torus = distortedTorus();
+    VoxelList listed;               // the active voxels of the leaves with x < 0
+    std::vector<openvdb::Coord> at; // their positions, in leaves
+    for (auto leaf = torus->tree().cbeginLeaf(); leaf; ++leaf) {
+        if (leaf->origin().x() >= 0) continue;
+        LeafVoxels entry{leaf->origin(), {}};
+        for (int x = 0; x < 8; ++x)
+            entry.words[std::size_t(x)] = leaf->getValueMask().getWord<leafwords::Word>(x);
+        listed.push_back(entry);
+        at.push_back(leaf->origin() >> 3);
+    }
+    // The torus's leaves next to a listed one, counted by brute force.
+    std::size_t near = 0, all = 0;
+    for (auto leaf = torus->tree().cbeginLeaf(); leaf; ++leaf, ++all) {
+        const openvdb::Coord p = leaf->origin() >> 3;
+        near += std::any_of(at.begin(), at.end(), [&](const openvdb::Coord& q) {
+            return std::abs(p.x() - q.x()) <= 1 && std::abs(p.y() - q.y()) <= 1 &&
+                   std::abs(p.z() - q.z()) <= 1;
+        });
+    }
+    // The torus and a ball of band beside it.
+    GridPtr both = torus->deepCopy();
+    const GridPtr ball = gridFromSdf(
+        [](const Eigen::Vector3d& p) { return (p - Eigen::Vector3d(2.5, 0.0, 0.0)).norm() - 0.3; },
+        1.0 / 48, 3, openvdb::CoordBBox::createCube({100, -20, -20}, 40));
+    for (auto leaf = ball->tree().cbeginLeaf(); leaf; ++leaf)
+        both->tree().addLeaf(new Grid::TreeType::LeafNodeType(*leaf));
+    openvdb::CoordBBox region = both->evalActiveVoxelBoundingBox();
+    region.expand(2);
+    GridPtr one = torus->deepCopy();
+    const FmmStats alone = renormalize(*one, region, listed);
+    const FmmStats beside = renormalize(*both, region, listed);
+    EXPECT_EQ(alone.leaves, near);
+    EXPECT_EQ(beside.leaves, near);
+    EXPECT_LT(near, all);
+    EXPECT_GT(alone.marched, 10000u);
+    EXPECT_EQ(alone.marched, beside.marched);
+    const auto b = both->getConstAccessor();
+    for (auto it = one->cbeginValueAll(); it; ++it) {
+        if (!it.isVoxelValue()) continue;
+        ASSERT_EQ(*it, b.getValue(it.getCoord())) << it.getCoord();
+    }
+    const auto kept = ball->getConstAccessor();
+    for (auto leaf = both->tree().cbeginLeaf(); leaf; ++leaf) {
+        if (leaf->origin().x() < 96) continue;
+        for (auto it = leaf->cbeginValueAll(); it; ++it)
+            ASSERT_EQ(*it, kept.getValue(it.getCoord()));
+    }
+}
+
 // relaxRow takes four lanes at a time on any CPU and eight at once with AVX2: both give the
 // same values and the same moved lanes, to the bit, with either stencil. (Both halves of a
 // row are solved from the row as it was: a half written before the other was solved would
