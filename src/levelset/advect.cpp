@@ -54,10 +54,35 @@ openvdb::Coord cellOf(const openvdb::Vec3d& p) {
     return openvdb::Coord(down(p[0]), down(p[1]), down(p[2]));
 }
 
-// What sampling reads: the grid as it was before sampling began. Sampling writes only the
-// leaves it resamples, so those are copied first (copy on write) and every other read goes
-// to the live grid, which nothing else changes meanwhile: the cost follows the brush, not
-// the model. Where the band had to be widened, the copies hold the widened band.
+// New values of the leaves a sampling pass resamples, kept beside the grid until every sample
+// is taken (samples read the grid as it was), then swapped in: 512 values a leaf, and per
+// leaf the voxels whose values changed (only those are written). Writing into the leaves
+// instead needed a copy of each one first (copy on write): some 2,000 leaves a drag segment
+// at 1/256, allocated, put in a tree on one thread and freed one at a time.
+struct Staged {
+    std::unique_ptr<float[]> values;
+    std::vector<leafwords::Words> changed;
+
+    // Swaps the staged values of the changed voxels with the leaves' (the staged values are
+    // then the old ones).
+    void swapInto(const std::vector<LeafNode*>& leaves) {
+        tbb::parallel_for(std::size_t(0), leaves.size(), [&](std::size_t l) {
+            float* const to = leaves[l]->buffer().data();
+            float* const from = &values[l * LeafNode::SIZE];
+            for (std::size_t x = 0; x < 8; ++x)
+                for (leafwords::Word w = changed[l][x]; w; w &= w - 1) {
+                    const std::size_t pos = x * 64 + std::size_t(__builtin_ctzll(w));
+                    std::swap(to[pos], from[pos]);
+                }
+        });
+    }
+};
+
+// What sampling reads: the grid as it was before sampling began. A segment's first pass reads
+// the live grid alone and writes beside it (Staged); otherwise sampling writes the leaves it
+// resamples, so those are copied first (copy on write) and every other read goes to the live
+// grid, which nothing else changes meanwhile: the cost follows the brush, not the model.
+// Where the band had to be widened, the copies hold the widened band.
 class SampleSource {
   public:
     SampleSource(const Grid& live, GridPtr copies) : live_(live), copies_(std::move(copies)) {}
@@ -66,8 +91,14 @@ class SampleSource {
                                                      const std::vector<LeafNode*>& leaves) {
         return std::make_shared<SampleSource>(live, copyLeaves(live, leaves));
     }
+    // The live grid alone (sampling writes elsewhere: Staged).
+    static std::shared_ptr<SampleSource> live(const Grid& live) {
+        return std::make_shared<SampleSource>(live, copyLeaves(live, std::vector<LeafNode*>{}));
+    }
     // Adds copies of these leaves (not copied yet), before sampling writes them.
     void copyAlso(const std::vector<LeafNode*>& leaves) { addCopies(*copies_, leaves); }
+    // Adds copies of leaves as they were before `staged` was swapped into them.
+    void copyAlso(const std::vector<LeafNode*>& leaves, const Staged& staged);
     // A grid holding copies of these leaves, with the live grid's transform and background.
     template <typename Leaves> static GridPtr copyLeaves(const Grid& live, const Leaves& leaves) {
         GridPtr copies = Grid::create(live.background());
@@ -153,6 +184,22 @@ class SampleSource {
     GridPtr copies_;
 };
 
+void SampleSource::copyAlso(const std::vector<LeafNode*>& leaves, const Staged& staged) {
+    std::vector<LeafNode*> made(leaves.size());
+    tbb::parallel_for(std::size_t(0), leaves.size(), [&](std::size_t l) {
+        made[l] = new LeafNode(*leaves[l]);
+        float* const to = made[l]->buffer().data();
+        const float* const from = &staged.values[l * LeafNode::SIZE];
+        for (std::size_t x = 0; x < 8; ++x)
+            for (leafwords::Word w = staged.changed[l][x]; w; w &= w - 1) {
+                const std::size_t pos = x * 64 + std::size_t(__builtin_ctzll(w));
+                to[pos] = from[pos];
+            }
+    });
+    for (LeafNode* leaf : made)
+        copies_->tree().addLeaf(leaf);
+}
+
 // The source values around one leaf, in a dense block: a leaf's pre-images of a drag lie
 // within a voxel or two of it, and their trilinear samples read the block by strides,
 // where each of them took a tree lookup, and eight where the cell crosses a leaf border.
@@ -206,7 +253,8 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 // map(x), and lists in `changed` the voxels whose value changed, a leaf at a time (a leaf
 // resampled again is listed again). When the source holds the grid's own values
 // (`sourceIsGrid`: no widened band), a voxel that the map leaves in place keeps its value
-// without interpolating: a sample at a voxel centre returns it exactly.
+// without interpolating: a sample at a voxel centre returns it exactly. With `staged`, the
+// new values go there and the leaves keep theirs.
 // A deformation that tears space (`tearing`) adds how deep x lies in what it opened. A point
 // it opened reads the largest value along the torn set within `tornWindow` of the point it
 // was torn from: on a grid, what the pinch's needles bring together (or the strangle's noose
@@ -218,10 +266,11 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
                      const StepDeformation* tearing, double tornWindow, Sampling sampling,
                      VoxelList& changed, Interrupter* interrupter,
-                     const openvdb::MaskTree* only = nullptr) {
+                     const openvdb::MaskTree* only = nullptr, Staged* staged = nullptr) {
     // Per leaf, the voxels whose value changed (a word per x, as the leaf's mask holds them):
     // written by the leaf's own task, then listed.
     std::vector<leafwords::Words> changedWords(leaves.size());
+    if (staged) staged->values.reset(new float[leaves.size() * LeafNode::SIZE]);
     std::atomic<std::size_t> count{0};
     // Per thread: the block of source values around a leaf, and the leaf's voxels to sample
     // with their places and pre-images.
@@ -265,7 +314,8 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                 s.y[std::size_t(i)] = map(s.x[std::size_t(i)]);
             }
             bool filled = false; // the block is filled for the leaf's first sample
-            float* values = leaf.buffer().data();
+            const float* values = leaf.buffer().data();
+            float* const out = staged ? &staged->values[l * LeafNode::SIZE] : leaf.buffer().data();
             for (int i = 0; i < listed; ++i) {
                 const int pos = s.at[std::size_t(i)];
                 const Eigen::Vector3d& x = s.x[std::size_t(i)];
@@ -298,7 +348,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                     !(before ? before->isValueOn(openvdb::Index(pos))
                              : acc.isValueOn(leaf.offsetToGlobalCoord(openvdb::Index(pos)))))
                     changedWords[l][std::size_t(pos >> 6)] |= leafwords::Word(1) << (pos & 63);
-                values[pos] = v;
+                out[pos] = v;
             }
             n += std::size_t(listed);
         }
@@ -307,6 +357,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     for (std::size_t l = 0; l < leaves.size(); ++l)
         if (leafwords::any(changedWords[l]))
             changed.push_back({leaves[l]->origin(), changedWords[l]});
+    if (staged) staged->changed = std::move(changedWords);
     return count;
 }
 
@@ -747,6 +798,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         return out;
     };
     std::vector<LeafNode*> moving = movingOf(sampled);
+    // (The sources of the sub-steps one at a time: the grid with copies of what they write.)
     auto source = [&](int k) {
         if (widened && k == 0) return std::make_shared<SampleSource>(grid, widened);
         auto copy = SampleSource::copyOnWrite(grid, moving);
@@ -760,14 +812,25 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     const double tornWindow = (std::ceil(halfWidth) + 1) * h; // see resample
     if (!options.resampleEachSubStep) {
         const auto map = [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); };
-        const auto from = source(0);
-        stats.sampledVoxels =
-            resample(grid, moving, *from, !widened, region, map, seg.tears() ? &seg : nullptr,
-                     tornWindow, options.sampling, changed, options.interrupter);
+        // Sampling reads the grid itself and writes beside it (staged), or, from a widened
+        // band, reads the copies that hold it and writes into the grid.
+        const auto from =
+            widened ? std::make_shared<SampleSource>(grid, widened) : SampleSource::live(grid);
+        Staged staged;
+        stats.sampledVoxels = resample(
+            grid, moving, *from, !widened, region, map, seg.tears() ? &seg : nullptr, tornWindow,
+            options.sampling, changed, options.interrupter, nullptr, widened ? nullptr : &staged);
+        if (!widened) {
+            staged.swapInto(moving);
+            stats.leavesCopied += moving.size();
+        }
         if (reach < bandReach && !seedsSampled(grid, moving, region)) {
             // A strong stretch spread the images apart: the images are dilated as far as the
             // band reaches, and the voxels that adds are sampled from the same source (the
-            // leaves it adds copied first, while they still hold their tiles' values).
+            // leaves it adds copied first, while they still hold their tiles' values). The
+            // leaves sampled already are copied as sampling found them, their values and
+            // their active voxels, before the band grows: their old values are staged now.
+            if (!widened) from->copyAlso(moving, staged);
             mask = dilatedByCube(mask, bandReach - reach);
             stats.sampledReach = bandReach;
             const VoxelList added = switchOn(mask);

@@ -48,7 +48,7 @@ struct AdvectStats {
     // size of the model (the same stroke counts the same on a grid holding more shapes).
     std::size_t voxelsVisited = 0; // scanned for the interface, sampled, marched over
     std::size_t leavesVisited = 0; // leaves those loops went through
-    std::size_t leavesCopied = 0;  // copied as the sampling source
+    std::size_t leavesCopied = 0;  // copied as the sampling source, or sampled beside the grid
     std::size_t leavesWidened = 0; // of those, whose band a stretch asked to be widened
     std::size_t leavesFlooded = 0; // whose inactive signs were re-derived
     std::size_t tornVoxels = 0;    // inside voxels beyond the band that a tear opened

@@ -6,9 +6,11 @@
 
 #include <gtest/gtest.h>
 #include <openvdb/tools/Composite.h>
+#include <openvdb/tools/Interpolation.h>
 
 #include "deform/inflate.h"
 #include "deform/pinch.h"
+#include "deform/swirl.h"
 #include "grids.h"
 #include "io/start_grid.h"
 #include "io/stroke_script.h"
@@ -221,6 +223,40 @@ TEST(Advect, SamplingReachesEverySeedOfRenormalization) {
     EXPECT_LT(largest, 0.2);
     const double exact = 4.0 / 3.0 * M_PI * std::pow(f * r, 3);
     EXPECT_NEAR(levelSetVolume(*g), exact, 0.01 * exact);
+}
+
+// Where the images of the surface land too far apart for the seeds without widening the band
+// (a swirl's segment at 1/128), the voxels the band's second growth adds are sampled in a
+// second pass, from the grid as the first pass found it: the first pass stages its values
+// beside the grid and swaps them in, the second reads copies of the leaves as they were.
+// Without renormalization, every voxel sampled holds the old grid's value at its pre-image.
+TEST(Advect, ASecondSamplingPassReadsTheGridAsItWas) {
+    SwirlSpec spec;
+    spec.at = {0.0, 0.95, 0.0};
+    spec.move = {0.0, 0.06, 0.0};
+    spec.radius = 0.25;
+    const SwirlSegment seg(spec);
+    const double h = 1.0 / 128;
+    const GridPtr before = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+    const GridPtr after = before->deepCopy();
+    AdvectOptions sampleOnly;
+    sampleOnly.renormalize = false;
+    const AdvectStats stats = advectSegment(*after, seg, sampleOnly);
+    EXPECT_EQ(stats.sampledReach, 4); // the second pass ran
+    EXPECT_EQ(stats.widenedTo, 3.0);  // from the grid itself, not from widened copies
+    const openvdb::tools::GridSampler<Grid, openvdb::tools::BoxSampler> old(*before);
+    const openvdb::CoordBBox region = indexBox(*after, seg.affectedBox(), 1);
+    std::size_t sampled = 0, off = 0;
+    for (auto it = after->cbeginValueOn(); it; ++it) {
+        if (!region.isInside(it.getCoord())) continue;
+        const Eigen::Vector3d x = toEigen(after->indexToWorld(it.getCoord()));
+        const Eigen::Vector3d y = seg.inverseMap(x);
+        if ((y - x).norm() < 1e-3 * h) continue;
+        ++sampled;
+        off += std::abs(*it - old.wsSample(toVdb(y))) > 1e-4 * h;
+    }
+    EXPECT_GT(sampled, 10000u);
+    EXPECT_EQ(off, 0u);
 }
 
 TEST(Advect, MonotoneCubicNeverOvershoots) {
