@@ -63,17 +63,22 @@ struct Staged {
     std::unique_ptr<float[]> values;
     std::vector<leafwords::Words> changed;
 
+    // Calls body(to, from, pos) for each changed voxel of the l-th leaf: its place in `to`
+    // (the leaf's 512 values) and in the staged values.
+    template <typename Body> void forEachChanged(std::size_t l, float* to, const Body& body) const {
+        float* const from = &values[l * LeafNode::SIZE];
+        for (std::size_t x = 0; x < 8; ++x)
+            for (leafwords::Word w = changed[l][x]; w; w &= w - 1)
+                body(to, from, x * 64 + std::size_t(__builtin_ctzll(w)));
+    }
+
     // Swaps the staged values of the changed voxels with the leaves' (the staged values are
     // then the old ones).
     void swapInto(const std::vector<LeafNode*>& leaves) {
         tbb::parallel_for(std::size_t(0), leaves.size(), [&](std::size_t l) {
-            float* const to = leaves[l]->buffer().data();
-            float* const from = &values[l * LeafNode::SIZE];
-            for (std::size_t x = 0; x < 8; ++x)
-                for (leafwords::Word w = changed[l][x]; w; w &= w - 1) {
-                    const std::size_t pos = x * 64 + std::size_t(__builtin_ctzll(w));
-                    std::swap(to[pos], from[pos]);
-                }
+            forEachChanged(
+                l, leaves[l]->buffer().data(),
+                [](float* to, float* from, std::size_t pos) { std::swap(to[pos], from[pos]); });
         });
     }
 };
@@ -188,13 +193,9 @@ void SampleSource::copyAlso(const std::vector<LeafNode*>& leaves, const Staged& 
     std::vector<LeafNode*> made(leaves.size());
     tbb::parallel_for(std::size_t(0), leaves.size(), [&](std::size_t l) {
         made[l] = new LeafNode(*leaves[l]);
-        float* const to = made[l]->buffer().data();
-        const float* const from = &staged.values[l * LeafNode::SIZE];
-        for (std::size_t x = 0; x < 8; ++x)
-            for (leafwords::Word w = staged.changed[l][x]; w; w &= w - 1) {
-                const std::size_t pos = x * 64 + std::size_t(__builtin_ctzll(w));
-                to[pos] = from[pos];
-            }
+        staged.forEachChanged(
+            l, made[l]->buffer().data(),
+            [](float* to, const float* from, std::size_t pos) { to[pos] = from[pos]; });
     });
     for (LeafNode* leaf : made)
         copies_->tree().addLeaf(leaf);
@@ -289,7 +290,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
         pollInterrupt(interrupter);
         for (std::size_t l = range.begin(); l != range.end(); ++l) {
             LeafNode& leaf = *leaves[l];
-            // The leaf as the source holds it (a copy: sampling writes this one), to tell
+            // The leaf as the source holds it (a copy where sampling writes this one), to tell
             // which voxels the band grew into.
             const LeafNode* before = acc.leafAt(leaf.origin());
             // With `only`, just the active voxels it holds are sampled.

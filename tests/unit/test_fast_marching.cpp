@@ -65,6 +65,14 @@ void distort(Grid& g) {
 }
 
 // A torus at 1/48 whose values distort() scaled: what the renormalization tests solve.
+// A leaf's active voxels, as a list entry.
+LeafVoxels activeVoxelsOf(const Grid::TreeType::LeafNodeType& leaf) {
+    LeafVoxels entry{leaf.origin(), {}};
+    for (int x = 0; x < 8; ++x)
+        entry.words[std::size_t(x)] = leaf.getValueMask().getWord<leafwords::Word>(x);
+    return entry;
+}
+
 GridPtr distortedTorus() {
     auto sdf = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
     GridPtr g = gridFromSdf(sdf, 1.0 / 48, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90));
@@ -355,9 +363,7 @@ TEST(FastMarching, OnlyTheListedVoxelsAreRenormalized) {
     VoxelList once, twice; // the active voxels of the leaves with x < 0
     for (auto leaf = distorted->tree().cbeginLeaf(); leaf; ++leaf) {
         if (leaf->origin().x() >= 0) continue;
-        LeafVoxels entry{leaf->origin(), {}};
-        for (int x = 0; x < 8; ++x)
-            entry.words[std::size_t(x)] = leaf->getValueMask().getWord<leafwords::Word>(x);
+        const LeafVoxels entry = activeVoxelsOf(*leaf);
         once.push_back(entry);
         LeafVoxels low = entry, high = entry;
         for (std::size_t x = 0; x < 8; ++x)
@@ -395,10 +401,7 @@ TEST(FastMarching, TheDomainIsTheLeavesAroundTheListedOnes) {
     std::vector<openvdb::Coord> at; // their positions, in leaves
     for (auto leaf = torus->tree().cbeginLeaf(); leaf; ++leaf) {
         if (leaf->origin().x() >= 0) continue;
-        LeafVoxels entry{leaf->origin(), {}};
-        for (int x = 0; x < 8; ++x)
-            entry.words[std::size_t(x)] = leaf->getValueMask().getWord<leafwords::Word>(x);
-        listed.push_back(entry);
+        listed.push_back(activeVoxelsOf(*leaf));
         at.push_back(leaf->origin() >> 3);
     }
     // The torus's leaves next to a listed one, counted by brute force.
