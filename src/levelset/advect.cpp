@@ -923,7 +923,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                     addBox(leaf.origin, leaf.words, 0);
         }
     }
-    // The segment's masks are freed here rather than by their destructors (freeOnThisThread).
+    // The threads' marks are freed here rather than by their destructors (freeOnThisThread).
     for (const openvdb::MaskTree::Ptr& m : marks)
         freeOnThisThread(*m);
     return stats;

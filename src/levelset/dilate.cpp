@@ -176,8 +176,7 @@ bool dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
             leaves.push_back(*it);
             continue;
         }
-        for (std::size_t x = 0; x < kDim; ++x)
-            leaves[std::size_t(slot)].bits[x] |= it->bits[x];
+        leafwords::unite(leaves[std::size_t(slot)].bits, it->bits);
     }
     // Cubes add up: past a leaf's width, dilate one leaf's width at a time.
     for (int left = radius; left > 0; left -= kDim) {
@@ -196,7 +195,7 @@ bool dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
 } // namespace
 
 VoxelList dilatedByCube(const VoxelList& from, int radius) {
-    if (radius < 0) throw std::invalid_argument("dilateByCube: a negative radius");
+    if (radius < 0) throw std::invalid_argument("dilatedByCube: a negative radius");
     if (radius == 0) return eachLeafOnce(from);
     std::vector<MaskLeaf> leaves(from.size());
     for (std::size_t i = 0; i < from.size(); ++i)
@@ -213,8 +212,7 @@ VoxelList eachLeafOnce(VoxelList list) {
     VoxelList out;
     for (const LeafVoxels& leaf : list) {
         if (!out.empty() && out.back().origin == leaf.origin) {
-            for (std::size_t x = 0; x < kDim; ++x)
-                out.back().words[x] |= leaf.words[x];
+            leafwords::unite(out.back().words, leaf.words);
             continue;
         }
         out.push_back(leaf);

@@ -387,7 +387,7 @@ class Renormalizer {
             within.resize(b_.leafCount());
             for (const LeafVoxels& leaf : *only) {
                 const int l = b_.indexOf(leaf.origin);
-                if (l >= 0) within[std::size_t(l)] = within[std::size_t(l)] | leaf.words;
+                if (l >= 0) leafwords::unite(within[std::size_t(l)], leaf.words);
             }
         }
         tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {

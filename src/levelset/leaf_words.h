@@ -45,6 +45,12 @@ inline bool any(const Words& set) {
     return all != 0;
 }
 
+// Adds the voxels of `from` to `into`.
+inline void unite(Words& into, const Words& from) {
+    for (std::size_t x = 0; x < into.size(); ++x)
+        into[x] |= from[x];
+}
+
 // The smallest leaf-local box holding every voxel of a set that holds one: lo and hi (bounds
 // included) along x, y and z, read from the words (the set's union folds into its rows).
 inline void bounds(const Words& set, int (&lo)[3], int (&hi)[3]) {
