@@ -2,13 +2,6 @@
 
 namespace sweepers {
 
-double falloffMu(double d, double lambda) {
-    if (d >= lambda) return 0.0;
-    if (d <= 0.0) return 1.0;
-    const double x = d / lambda;
-    return 1.0 + x * x * x * (x * (15.0 - 6.0 * x) - 10.0);
-}
-
 double falloffMuDerivative(double d, double lambda) {
     if (d >= lambda || d <= 0.0) return 0.0;
     // d/dx (1 - 10x^3 + 15x^4 - 6x^5) = -30 x^2 (1 - x)^2

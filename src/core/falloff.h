@@ -8,8 +8,14 @@
 namespace sweepers {
 
 // mu_lambda(d) = 1 + (d/l)^3 ((d/l)(15 - 6 d/l) - 10) for d < lambda, 0 beyond (3.2).
-// Distances to a tool are never negative, so d <= 0 gives 1.
-double falloffMu(double d, double lambda);
+// Distances to a tool are never negative, so d <= 0 gives 1. Inline: the inverse map
+// evaluates it at every voxel a segment samples.
+inline double falloffMu(double d, double lambda) {
+    if (d >= lambda) return 0.0;
+    if (d <= 0.0) return 1.0;
+    const double x = d / lambda;
+    return 1.0 + x * x * x * (x * (15.0 - 6.0 * x) - 10.0);
+}
 
 // d mu_lambda / dd.
 double falloffMuDerivative(double d, double lambda);

@@ -17,12 +17,24 @@ Eigen::Vector3d StepDeformation::inverseMap(const Eigen::Vector3d& p) const {
     return q;
 }
 
+void StepDeformation::inverseMaps(const Eigen::Vector3d* p, std::size_t n,
+                                  Eigen::Vector3d* out) const {
+    for (std::size_t i = 0; i < n; ++i)
+        out[i] = inverseMap(p[i]);
+}
+
 ForwardResult StepDeformation::forwardStep(int k, const Eigen::Vector3d& q,
                                            double tolerance) const {
     return iterateForward(q, tolerance, forwardMaxIterations_, [&](const Eigen::Vector3d& p) {
         const std::optional<MotionLog> L = stepLog(k, p);
         return L ? L->applyExp(q) : q;
     });
+}
+
+void StepDeformation::forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, double tolerance,
+                                   Eigen::Vector3d* out) const {
+    for (std::size_t i = 0; i < n; ++i)
+        out[i] = forwardStep(k, q[i], tolerance).p;
 }
 
 ForwardResult StepDeformation::forwardMap(const Eigen::Vector3d& p) const {

@@ -40,12 +40,19 @@ class StepDeformation {
     virtual Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const;
     // Whole inverse: inverse sub-steps s-1 down to 0.
     Eigen::Vector3d inverseMap(const Eigen::Vector3d& p) const;
+    // The whole inverse at the n points p, into out (the same values as inverseMap, to the
+    // bit): sampling maps a leaf's voxels in one call.
+    virtual void inverseMaps(const Eigen::Vector3d* p, std::size_t n, Eigen::Vector3d* out) const;
     // Forward sub-step k: the p with inverseStep(k, p) = q, to `tolerance` (relative to
     // 1 + |q|; forwardTolerance() when 0). inverseStep(k, p) = exp(-L(p)) p = q holds
     // exactly when p = exp(L(p)) q, which is iterated on p: a contraction wherever the
     // sub-step is fold-over free.
     virtual ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
                                       double tolerance = 0.0) const;
+    // forwardStep(k, q[i], tolerance).p for the n points q, into out (the same values, to
+    // the bit): the band's growth maps a run of interface voxels in one call.
+    virtual void forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, double tolerance,
+                              Eigen::Vector3d* out) const;
     // Whole forward map: forward sub-steps 0 up to s-1.
     ForwardResult forwardMap(const Eigen::Vector3d& p) const;
 

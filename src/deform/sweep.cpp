@@ -157,6 +157,35 @@ Eigen::Vector3d SweepSegment::inverseStep(int k, const Eigen::Vector3d& p) const
     return phi == 0.0 ? p : tools_[0].stepLog.applyExp(-phi, p); // 5.18
 }
 
+void SweepSegment::inverseMaps(const Eigen::Vector3d* p, std::size_t n,
+                               Eigen::Vector3d* out) const {
+    if (tools_.size() != 1) return StepDeformation::inverseMaps(p, n, out);
+    // inverseMap a sub-step at a time over all the points: those in the sub-step's box are
+    // gathered and their influences found in one call (a call per point went through
+    // inverseStep, influence and the shape's distance, two of them virtual).
+    thread_local std::vector<std::size_t> moved, in;
+    thread_local std::vector<Eigen::Vector3d> points;
+    thread_local std::vector<double> phi;
+    moved.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+        out[i] = p[i];
+        if (!stillAt(p[i])) moved.push_back(i);
+    }
+    for (int k = steps_ - 1; k >= 0; --k) {
+        in.clear();
+        points.clear();
+        for (const std::size_t i : moved)
+            if (stepBoxes_[std::size_t(k)].contains(out[i])) {
+                in.push_back(i);
+                points.push_back(out[i]);
+            }
+        phi.resize(points.size());
+        tools_[0].placed[std::size_t(k) + 1]->influences(points.data(), points.size(), phi.data());
+        for (std::size_t j = 0; j < in.size(); ++j)
+            if (phi[j] != 0.0) out[in[j]] = tools_[0].stepLog.applyExp(-phi[j], points[j]); // 5.18
+    }
+}
+
 ForwardResult SweepSegment::forwardStep(int k, const Eigen::Vector3d& q, double tolerance) const {
     if (tools_.size() != 1) return StepDeformation::forwardStep(k, q, tolerance);
     // p = exp(phi(p) L) q, iterated (INVERTFASTER, 5.4.1).
@@ -164,6 +193,48 @@ ForwardResult SweepSegment::forwardStep(int k, const Eigen::Vector3d& q, double 
         const double phi = oneToolInfluence(k, p);
         return phi == 0.0 ? q : tools_[0].stepLog.applyExp(phi, q);
     });
+}
+
+void SweepSegment::forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, double tolerance,
+                                Eigen::Vector3d* out) const {
+    if (tools_.size() != 1) return StepDeformation::forwardSteps(k, q, n, tolerance, out);
+    // forwardStep's iteration run on all the points at once, each until it converges (to the
+    // bit what it gives one point at a time): the influences of the points still iterating
+    // in the sub-step's box are found in one call per iteration.
+    thread_local std::vector<std::size_t> iterating, in;
+    thread_local std::vector<Eigen::Vector3d> points;
+    thread_local std::vector<double> tol, phi;
+    const double relative = tolerance > 0.0 ? tolerance : forwardTolerance_;
+    iterating.resize(n);
+    tol.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        out[i] = q[i];
+        iterating[i] = i;
+        tol[i] = relative * (1.0 + q[i].norm());
+    }
+    const PlacedTool& tool = *tools_[0].placed[std::size_t(k) + 1];
+    for (int it = 1; it <= forwardMaxIterations_ && !iterating.empty(); ++it) {
+        in.clear();
+        points.clear();
+        for (const std::size_t i : iterating)
+            if (stepBoxes_[std::size_t(k)].contains(out[i])) {
+                in.push_back(i);
+                points.push_back(out[i]);
+            }
+        phi.resize(points.size());
+        tool.influences(points.data(), points.size(), phi.data());
+        // Each point's next iterate: q where its influence is 0 (outside the box too).
+        std::size_t j = 0, kept = 0;
+        for (const std::size_t i : iterating) {
+            double w = 0.0;
+            if (j < in.size() && in[j] == i) w = phi[j++];
+            const Eigen::Vector3d next = w == 0.0 ? q[i] : tools_[0].stepLog.applyExp(w, q[i]);
+            const double change = (next - out[i]).norm();
+            out[i] = next;
+            if (change > tol[i]) iterating[kept++] = i;
+        }
+        iterating.resize(kept);
+    }
 }
 
 std::optional<MotionLog> SweepSegment::stepLog(int k, const Eigen::Vector3d& p) const {

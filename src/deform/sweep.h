@@ -73,6 +73,9 @@ class SweepSegment : public StepDeformation {
     // For one tool, the blend is its influence times its log (3.17 with c phi = phi): the
     // sub-steps apply that directly. Several tools take the blend of stepLog.
     Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const override;
+    void inverseMaps(const Eigen::Vector3d* p, std::size_t n, Eigen::Vector3d* out) const override;
+    void forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, double tolerance,
+                      Eigen::Vector3d* out) const override;
     ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
                               double tolerance = 0.0) const override;
 

@@ -251,8 +251,9 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 }
 
 // Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
-// map(x), and lists in `changed` the voxels whose value changed, a leaf at a time (a leaf
-// resampled again is listed again). When the source holds the grid's own values
+// the pre-image of x (`map(x, n, y)` maps a leaf's n voxels x at once, into y), and lists in
+// `changed` the voxels whose value changed, a leaf at a time (a leaf resampled again is listed
+// again). When the source holds the grid's own values
 // (`sourceIsGrid`: no widened band), a voxel that the map leaves in place keeps its value
 // without interpolating: a sample at a voxel centre returns it exactly. With `staged`, the
 // new values go there and the leaves keep theirs.
@@ -312,8 +313,8 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
             for (int i = 0; i < listed; ++i) {
                 const openvdb::Coord ijk = LeafNode::offsetToLocalCoord(s.at[std::size_t(i)]);
                 s.x[std::size_t(i)] = toEigen(place.toWorld((leaf.origin() + ijk).asVec3d()));
-                s.y[std::size_t(i)] = map(s.x[std::size_t(i)]);
             }
+            map(s.x.data(), std::size_t(listed), s.y.data());
             bool filled = false; // the block is filled for the leaf's first sample
             const float* values = leaf.buffer().data();
             float* const out = staged ? &staged->values[l * LeafNode::SIZE] : leaf.buffer().data();
@@ -648,14 +649,22 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
         pollInterrupt(options.interrupter);
         openvdb::tree::ValueAccessor<openvdb::MaskTree, false> m(*marks.local());
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            Eigen::Vector3d p = toEigen(place.toWorld(interface[i].asVec3d()));
-            for (int k = 0; k < seg.steps(); ++k) {
-                p = seg.forwardStep(k, p, forwardTolerance).p;
-                // Intermediate surfaces only need a band when they are stored.
-                if (options.resampleEachSubStep || k + 1 == seg.steps())
+        // The range's voxels are mapped a sub-step at a time, all at once.
+        thread_local std::vector<Eigen::Vector3d> images, next;
+        images.resize(r.size());
+        next.resize(r.size());
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+            images[i - r.begin()] = toEigen(place.toWorld(interface[i].asVec3d()));
+        for (int k = 0; k < seg.steps(); ++k) {
+            seg.forwardSteps(k, images.data(), images.size(), forwardTolerance, next.data());
+            images.swap(next);
+            // Intermediate surfaces only need a band when they are stored.
+            if (options.resampleEachSubStep || k + 1 == seg.steps())
+                for (const Eigen::Vector3d& p : images)
                     m.setValueOn(openvdb::Coord::round(place.toIndex(toVdb(p))));
-            }
+        }
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            const Eigen::Vector3d& p = images[i - r.begin()];
             if (!measureStretch || i % kStretchSampling != 0) continue;
             // How far the inverse map can spread a voxel-sized neighbourhood of the new
             // surface: the largest singular value of its Jacobian.
@@ -812,7 +821,9 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     const openvdb::CoordBBox touched = changedRegion(grid, seg);
     const double tornWindow = (std::ceil(halfWidth) + 1) * h; // see resample
     if (!options.resampleEachSubStep) {
-        const auto map = [&](const Eigen::Vector3d& x) { return seg.inverseMap(x); };
+        const auto map = [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y) {
+            seg.inverseMaps(x, n, y);
+        };
         // Sampling reads the grid itself and writes beside it (staged), or, from a widened
         // band, reads the copies that hold it and writes into the grid.
         const auto from =
@@ -870,7 +881,10 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             const auto from = source(k);
             stats.sampledVoxels += resample(
                 grid, moving, *from, !widened || k > 0, region,
-                [&](const Eigen::Vector3d& x) { return seg.inverseStep(k, x); },
+                [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y) {
+                    for (std::size_t i = 0; i < n; ++i)
+                        y[i] = seg.inverseStep(k, x[i]);
+                },
                 seg.tears() ? &seg : nullptr, tornWindow, options.sampling, changed,
                 options.interrupter);
             from->freeCopies();

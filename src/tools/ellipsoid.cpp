@@ -9,11 +9,16 @@ namespace sweepers {
 
 namespace {
 
-class PlacedBall : public PlacedShape {
+class PlacedBall final : public PlacedShape {
   public:
     PlacedBall(const Eigen::Vector3d& c, double r) : c_(c), r_(r) {}
     double distance(const Eigen::Vector3d& p) const override {
         return std::max(0.0, (p - c_).norm() - r_);
+    }
+    void distancesBelow(const Eigen::Vector3d* p, std::size_t n, double /*cutoff*/,
+                        double* out) const override {
+        for (std::size_t i = 0; i < n; ++i)
+            out[i] = distance(p[i]);
     }
     Box bounds() const override { return {c_.array() - r_, c_.array() + r_}; }
 

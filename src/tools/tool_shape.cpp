@@ -22,4 +22,10 @@ double PlacedTool::influence(const Eigen::Vector3d& p) const {
     return falloffMu(shape_->distanceBelow(p, falloff_), falloff_);
 }
 
+void PlacedTool::influences(const Eigen::Vector3d* p, std::size_t n, double* out) const {
+    shape_->distancesBelow(p, n, falloff_, out);
+    for (std::size_t i = 0; i < n; ++i)
+        out[i] = coating_.contains(p[i]) ? falloffMu(out[i], falloff_) : 0.0;
+}
+
 } // namespace sweepers

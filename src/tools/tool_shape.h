@@ -29,6 +29,13 @@ class PlacedShape {
     virtual double distanceBelow(const Eigen::Vector3d& p, double /*cutoff*/) const {
         return distance(p);
     }
+    // distanceBelow at the n points p, into out: one call for a leaf's voxels, where a call
+    // per voxel went through two virtual calls.
+    virtual void distancesBelow(const Eigen::Vector3d* p, std::size_t n, double cutoff,
+                                double* out) const {
+        for (std::size_t i = 0; i < n; ++i)
+            out[i] = distanceBelow(p[i], cutoff);
+    }
     // World box enclosing the shape.
     virtual Box bounds() const = 0;
     // A bound on |grad distance|. An exact distance has 1; a sampled one (a baked tool)
@@ -57,6 +64,8 @@ class PlacedTool {
     PlacedTool(std::unique_ptr<PlacedShape> shape, double falloff);
 
     double influence(const Eigen::Vector3d& p) const;
+    // influence at the n points p, into out (the same values, to the bit).
+    void influences(const Eigen::Vector3d* p, std::size_t n, double* out) const;
     double distance(const Eigen::Vector3d& p) const { return shape_->distance(p); }
     // Box enclosing the tool and its coating: outside it the influence is exactly 0.
     const Box& coatingBounds() const { return coating_; }

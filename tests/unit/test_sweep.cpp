@@ -128,6 +128,36 @@ TEST(Sweep, OneToolStepsAreTheBlendsOfOne) {
     }
 }
 
+// Sampling maps a leaf's voxels in one call, and the band's growth a run of interface
+// voxels: the batches give what the maps give one point at a time, to the bit, for every
+// kind of motion, one tool or several, with points inside the tools, on their coatings and
+// beyond the affected box.
+TEST(Sweep, BatchesMapAsOnePointAtATime) {
+    Rng rng(19);
+    for (const Case& c : cases()) {
+        const SweepSegment seg(c.sweep, 0);
+        const Box& box = seg.affectedBox();
+        const Eigen::Vector3d margin = 0.2 * (box.max - box.min);
+        std::vector<Eigen::Vector3d> p(700), batch(p.size());
+        for (Eigen::Vector3d& x : p)
+            x = rng.inBox(box.min - margin, box.max + margin);
+        seg.inverseMaps(p.data(), p.size(), batch.data());
+        int moved = 0;
+        for (std::size_t i = 0; i < p.size(); ++i) {
+            ASSERT_EQ(batch[i], seg.inverseMap(p[i])) << c.name << " point " << i;
+            moved += batch[i] != p[i];
+        }
+        EXPECT_GT(moved, 50) << c.name;
+        for (int k = 0; k < seg.steps(); ++k)
+            for (const double tolerance : {0.0, 1e-4}) {
+                seg.forwardSteps(k, p.data(), p.size(), tolerance, batch.data());
+                for (std::size_t i = 0; i < p.size(); ++i)
+                    ASSERT_EQ(batch[i], seg.forwardStep(k, p[i], tolerance).p)
+                        << c.name << " sub-step " << k << " point " << i;
+            }
+    }
+}
+
 TEST(Sweep, SegmentMapIsFoldOverFree) {
     // Random tools and motions; the finite-difference Jacobian determinant of the composed
     // segment map is positive everywhere in the affected box.
