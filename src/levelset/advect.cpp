@@ -629,10 +629,11 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         });
     }
     stats.interfaceVoxels = interface.size();
-    // Each thread marks the images in a mask of its own; the masks are merged after, into the
-    // first of them (copying it into an empty tree made every leaf and node again).
-    tbb::enumerable_thread_specific<openvdb::MaskTree::Ptr> marks(
-        [] { return std::make_shared<openvdb::MaskTree>(); });
+    // Each thread lists the images leaf by leaf, a list of its own, a run of interface voxels
+    // at a time; a leaf the runs share is listed by each (dilatedByCube joins the entries).
+    // Marked in a tree per thread, they cost a tree's look-up per image and, at 1/256, some
+    // 1 ms a drag segment to mark, list and free.
+    tbb::enumerable_thread_specific<VoxelList> marks;
     const VoxelPlacement place(grid.transform());
     // The voxels the renormalization seeds from lie within 1.5 voxels of the new surface
     // (crossing ends and their central differences); their pre-images lie within
@@ -648,7 +649,22 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     std::vector<double> stretchAt(interface.size() / kStretchSampling + 1, 1.0);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
         pollInterrupt(options.interrupter);
-        openvdb::tree::ValueAccessor<openvdb::MaskTree, false> m(*marks.local());
+        VoxelList& marked = marks.local();
+        const std::size_t run = marked.size(); // this run's entries start here
+        // The images of a run of voxels next to each other fall into a few leaves: its
+        // entries are searched from the one marked last.
+        std::size_t last = run;
+        const auto mark = [&](const openvdb::Coord& c) {
+            const openvdb::Coord origin(c.x() & ~7, c.y() & ~7, c.z() & ~7);
+            if (last == marked.size() || marked[last].origin != origin) {
+                last = marked.size();
+                for (std::size_t e = run; e < marked.size(); ++e)
+                    if (marked[e].origin == origin) last = e;
+                if (last == marked.size()) marked.push_back({origin, {}});
+            }
+            const int off = (c.x() & 7) << 6 | (c.y() & 7) << 3 | (c.z() & 7);
+            marked[last].words[std::size_t(off >> 6)] |= leafwords::Word(1) << (off & 63);
+        };
         // The range's voxels are mapped a sub-step at a time, all at once.
         thread_local std::vector<Eigen::Vector3d> images, next;
         images.resize(r.size());
@@ -661,7 +677,7 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             // Intermediate surfaces only need a band when they are stored.
             if (options.resampleEachSubStep || k + 1 == seg.steps())
                 for (const Eigen::Vector3d& p : images)
-                    m.setValueOn(openvdb::Coord::round(place.toIndex(toVdb(p))));
+                    mark(openvdb::Coord::round(place.toIndex(toVdb(p))));
         }
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
             const Eigen::Vector3d& p = images[i - r.begin()];
@@ -681,12 +697,10 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             stretchAt[i / kStretchSampling] = std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
         }
     });
-    // The images, listed from each thread's marks (a leaf two threads marked, twice).
+    // The images, from each thread's list.
     VoxelList images;
-    for (const openvdb::MaskTree::Ptr& m : marks) {
-        const VoxelList listed = listLeaves(*m);
-        images.insert(images.end(), listed.begin(), listed.end());
-    }
+    for (const VoxelList& marked : marks)
+        images.insert(images.end(), marked.begin(), marked.end());
     // The band the images are dilated into, sampled: what renormalization's seeds read (the
     // voxels next to the new crossing and their face neighbours) lies within kSeedReach of
     // them, and sampling is checked to have reached it all (else the images are dilated as
@@ -937,9 +951,6 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
                     addBox(leaf.origin, leaf.words, 0);
         }
     }
-    // The threads' marks are freed here rather than by their destructors (freeOnThisThread).
-    for (const openvdb::MaskTree::Ptr& m : marks)
-        freeOnThisThread(*m);
     return stats;
 }
 
