@@ -62,11 +62,15 @@ LeafNode::NodeMaskType crossingVoxels(const LeafNode& leaf, const Grid::ConstAcc
             // The facing layer of the next leaf, or a tile's one sign where there is none.
             const float* n = next ? next->buffer().data() : nullptr;
             const bool tileInside = !next && acc.getValue(o) < 0.0f;
+            // Along x the facing layer is one word, which only the word at the face reads.
+            Word facingX = 0;
+            if constexpr (A == 0)
+                facingX = n ? signs(n, dir > 0 ? 0 : 7 * 64, 64, 1) : tileInside ? ~Word(0) : 0;
             for (int x = 0; x < 8; ++x) {
                 const std::size_t sx = std::size_t(x);
                 Word facing = 0;
                 if constexpr (A == 0) {
-                    facing = n ? signs(n, dir > 0 ? 0 : 7 * 64, 64, 1) : tileInside ? ~Word(0) : 0;
+                    facing = facingX;
                 } else if constexpr (A == 1) {
                     facing = n            ? signs(n, 64 * sx + (dir > 0 ? 0 : 56), 8, 1)
                              : tileInside ? leafwords::kY0
