@@ -163,27 +163,33 @@ void SweepSegment::inverseMaps(const Eigen::Vector3d* p, std::size_t n,
     // inverseMap a sub-step at a time over all the points: those in the sub-step's box are
     // gathered and their influences found in one call (a call per point went through
     // inverseStep, influence and the shape's distance, two of them virtual).
-    thread_local std::vector<std::size_t> moved, in;
-    thread_local std::vector<Eigen::Vector3d> points;
-    thread_local std::vector<double> phi;
+    thread_local std::vector<std::size_t> moved;
+    thread_local InBox box;
     moved.clear();
     for (std::size_t i = 0; i < n; ++i) {
         out[i] = p[i];
         if (!stillAt(p[i])) moved.push_back(i);
     }
     for (int k = steps_ - 1; k >= 0; --k) {
-        in.clear();
-        points.clear();
-        for (const std::size_t i : moved)
-            if (stepBoxes_[std::size_t(k)].contains(out[i])) {
-                in.push_back(i);
-                points.push_back(out[i]);
-            }
-        phi.resize(points.size());
-        tools_[0].placed[std::size_t(k) + 1]->influences(points.data(), points.size(), phi.data());
-        for (std::size_t j = 0; j < in.size(); ++j)
-            if (phi[j] != 0.0) out[in[j]] = tools_[0].stepLog.applyExp(-phi[j], points[j]); // 5.18
+        influencesInBox(k, moved, out, box);
+        for (std::size_t j = 0; j < box.index.size(); ++j)
+            if (box.phi[j] != 0.0) // 5.18
+                out[box.index[j]] = tools_[0].stepLog.applyExp(-box.phi[j], box.points[j]);
     }
+}
+
+void SweepSegment::influencesInBox(int k, const std::vector<std::size_t>& which,
+                                   const Eigen::Vector3d* at, InBox& into) const {
+    into.index.clear();
+    into.points.clear();
+    for (const std::size_t i : which)
+        if (stepBoxes_[std::size_t(k)].contains(at[i])) {
+            into.index.push_back(i);
+            into.points.push_back(at[i]);
+        }
+    into.phi.resize(into.points.size());
+    tools_[0].placed[std::size_t(k) + 1]->influences(into.points.data(), into.points.size(),
+                                                     into.phi.data());
 }
 
 ForwardResult SweepSegment::forwardStep(int k, const Eigen::Vector3d& q, double tolerance) const {
@@ -201,9 +207,9 @@ void SweepSegment::forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, 
     // forwardStep's iteration run on all the points at once, each until it converges (to the
     // bit what it gives one point at a time): the influences of the points still iterating
     // in the sub-step's box are found in one call per iteration.
-    thread_local std::vector<std::size_t> iterating, in;
-    thread_local std::vector<Eigen::Vector3d> points;
-    thread_local std::vector<double> tol, phi;
+    thread_local std::vector<std::size_t> iterating;
+    thread_local std::vector<double> tol;
+    thread_local InBox box;
     const double relative = tolerance > 0.0 ? tolerance : forwardTolerance_;
     iterating.resize(n);
     tol.resize(n);
@@ -212,22 +218,13 @@ void SweepSegment::forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, 
         iterating[i] = i;
         tol[i] = relative * (1.0 + q[i].norm());
     }
-    const PlacedTool& tool = *tools_[0].placed[std::size_t(k) + 1];
     for (int it = 1; it <= forwardMaxIterations_ && !iterating.empty(); ++it) {
-        in.clear();
-        points.clear();
-        for (const std::size_t i : iterating)
-            if (stepBoxes_[std::size_t(k)].contains(out[i])) {
-                in.push_back(i);
-                points.push_back(out[i]);
-            }
-        phi.resize(points.size());
-        tool.influences(points.data(), points.size(), phi.data());
+        influencesInBox(k, iterating, out, box);
         // Each point's next iterate: q where its influence is 0 (outside the box too).
         std::size_t j = 0, kept = 0;
         for (const std::size_t i : iterating) {
             double w = 0.0;
-            if (j < in.size() && in[j] == i) w = phi[j++];
+            if (j < box.index.size() && box.index[j] == i) w = box.phi[j++];
             const Eigen::Vector3d next = w == 0.0 ? q[i] : tools_[0].stepLog.applyExp(w, q[i]);
             const double change = (next - out[i]).norm();
             out[i] = next;

@@ -91,6 +91,16 @@ class SweepSegment : public StepDeformation {
                    : 0.0;
     }
 
+    // The points at[i], i in `which` (in order), that lie in sub-step k's box, and the one
+    // tool's influence there (influence, to the bit): what the batched maps gather.
+    struct InBox {
+        std::vector<std::size_t> index;
+        std::vector<Eigen::Vector3d> points;
+        std::vector<double> phi;
+    };
+    void influencesInBox(int k, const std::vector<std::size_t>& which, const Eigen::Vector3d* at,
+                         InBox& into) const;
+
     struct ToolPlan {
         MotionLog log;                                   // log M_j for the whole segment
         MotionLog stepLog;                               // log M_j / s
