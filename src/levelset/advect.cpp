@@ -666,21 +666,21 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             marked[last].words[std::size_t(off >> 6)] |= leafwords::Word(1) << (off & 63);
         };
         // The range's voxels are mapped a sub-step at a time, all at once.
-        thread_local std::vector<Eigen::Vector3d> images, next;
-        images.resize(r.size());
+        thread_local std::vector<Eigen::Vector3d> mapped, next;
+        mapped.resize(r.size());
         next.resize(r.size());
         for (std::size_t i = r.begin(); i != r.end(); ++i)
-            images[i - r.begin()] = toEigen(place.toWorld(interface[i].asVec3d()));
+            mapped[i - r.begin()] = toEigen(place.toWorld(interface[i].asVec3d()));
         for (int k = 0; k < seg.steps(); ++k) {
-            seg.forwardSteps(k, images.data(), images.size(), forwardTolerance, next.data());
-            images.swap(next);
+            seg.forwardSteps(k, mapped.data(), mapped.size(), forwardTolerance, next.data());
+            mapped.swap(next);
             // Intermediate surfaces only need a band when they are stored.
             if (options.resampleEachSubStep || k + 1 == seg.steps())
-                for (const Eigen::Vector3d& p : images)
+                for (const Eigen::Vector3d& p : mapped)
                     mark(openvdb::Coord::round(place.toIndex(toVdb(p))));
         }
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const Eigen::Vector3d& p = images[i - r.begin()];
+            const Eigen::Vector3d& p = mapped[i - r.begin()];
             if (!measureStretch || i % kStretchSampling != 0) continue;
             // How far the inverse map can spread a voxel-sized neighbourhood of the new
             // surface: the largest singular value of its Jacobian.
