@@ -655,15 +655,15 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
         // entries are searched from the one marked last.
         std::size_t last = run;
         const auto mark = [&](const openvdb::Coord& c) {
-            const openvdb::Coord origin(c.x() & ~7, c.y() & ~7, c.z() & ~7);
+            const openvdb::Coord origin = c & ~int(LeafNode::DIM - 1);
             if (last == marked.size() || marked[last].origin != origin) {
-                last = marked.size();
-                for (std::size_t e = run; e < marked.size(); ++e)
-                    if (marked[e].origin == origin) last = e;
+                last = run;
+                while (last < marked.size() && marked[last].origin != origin)
+                    ++last;
                 if (last == marked.size()) marked.push_back({origin, {}});
             }
-            const int off = (c.x() & 7) << 6 | (c.y() & 7) << 3 | (c.z() & 7);
-            marked[last].words[std::size_t(off >> 6)] |= leafwords::Word(1) << (off & 63);
+            const openvdb::Index off = LeafNode::coordToOffset(c);
+            marked[last].words[off >> 6] |= leafwords::Word(1) << (off & 63);
         };
         // The range's voxels are mapped a sub-step at a time, all at once.
         thread_local std::vector<Eigen::Vector3d> mapped, next;
