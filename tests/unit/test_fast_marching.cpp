@@ -219,6 +219,45 @@ TEST(FastMarching, SolvesTheUpwindEquationsInAPartOfTheBand) {
         openvdb::CoordBBox({-13, -40, -20}, {40, 11, 20}));
 }
 
+// A second-order stencil reads two voxels along an axis, so a leaf's change one layer in from
+// a face reaches its neighbour's face voxels through the face layer. Where that layer is kept,
+// as at the edge of what a segment frees, the change one layer in is all there is to hand on.
+// Here a plane's distances grow from leaf L (x from -8 to -1) into leaf N (x from 0 to 7),
+// scaled by 1.3, and L's face layer (x = -1) is kept. N is solved first (its leaf position's
+// parity is even) from L's old values, two voxels in: handed nothing, N's face voxels would
+// keep what those gave, 0.14 voxel off their upwind value.
+TEST(FastMarching, AChangeOneLayerInFromAFaceReachesTheNeighbour) {
+    const double h = 1.0 / 48;
+    const double plane = documentTransform(h)->indexToWorld(openvdb::Vec3d(-3.5, 0, 0)).x();
+    GridPtr g = gridFromSdf([&](const Eigen::Vector3d& p) { return p.x() - plane; }, h, 6,
+                            openvdb::CoordBBox({-16, -8, -8}, {15, 15, 15}));
+    for (auto it = g->beginValueOn(); it; ++it)
+        it.setValue(1.3f * *it);
+    LeafVoxels l{{-8, 0, 0}, {}}, n{{0, 0, 0}, {}};
+    for (std::size_t x = 0; x < 8; ++x) {
+        l.words[x] = x == 7 ? 0 : ~leafwords::Word(0);
+        n.words[x] = ~leafwords::Word(0);
+    }
+    const openvdb::CoordBBox both({-8, 0, 0}, {7, 7, 7});
+    renormalize(*g, both, VoxelList{l, n}, FmmOrder::Second);
+    const auto acc = g->getConstAccessor();
+    double worst = 0.0;
+    std::size_t solved = 0;
+    for (auto it = both.begin(); it; ++it) {
+        const openvdb::Coord c = *it;
+        const LeafNode* leaf = acc.probeConstLeaf(c);
+        if (c.x() == -1 || !acc.isValueOn(c) || nextToCrossing(*leaf, leaf->coordToOffset(c), acc))
+            continue; // kept, outside the band, or a seed
+        worst = std::max(worst, std::abs(upwindValue(acc, c, h) - std::abs(acc.getValue(c))) / h);
+        ++solved;
+    }
+    EXPECT_GT(solved, 400u);
+    EXPECT_LT(worst, 1e-4);
+    // N's face voxels read L's face layer, kept, and the solved layer beyond it.
+    const double kept = acc.getValue({-1, 3, 3}), beyond = acc.getValue({-2, 3, 3});
+    EXPECT_NEAR(acc.getValue({0, 3, 3}), (4.0 * kept - beyond) / 3.0 + h / 1.5, 1e-4 * h);
+}
+
 TEST(FastMarching, RenormalizesADistortedSphere) {
     const double h = 1.0 / 48;
     auto sdf = [](const Eigen::Vector3d& p) { return p.norm() - 0.8; };
