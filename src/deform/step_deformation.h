@@ -85,6 +85,12 @@ class StepDeformation {
     virtual double stretchBound() const { return std::numeric_limits<double>::infinity(); }
 
   protected:
+    // How far apart two iterates of a forward step from q may be to stop: `tolerance`
+    // (forwardTolerance() when 0) relative to 1 + |q|.
+    double forwardToleranceAt(const Eigen::Vector3d& q, double tolerance) const {
+        return (tolerance > 0.0 ? tolerance : forwardTolerance_) * (1.0 + q.norm());
+    }
+
     // Solves p = next(p) for the p that sub-step k maps back onto q, by fixed-point
     // iteration from q to `tolerance` (relative to 1 + |q|; forwardTolerance() when 0), in
     // at most maxIterations steps (converged false when they run out).
@@ -92,7 +98,7 @@ class StepDeformation {
     ForwardResult iterateForward(const Eigen::Vector3d& q, double tolerance, int maxIterations,
                                  const Next& next) const {
         ForwardResult r{q, false, 0};
-        const double tol = (tolerance > 0.0 ? tolerance : forwardTolerance_) * (1.0 + q.norm());
+        const double tol = forwardToleranceAt(q, tolerance);
         for (int it = 1; it <= maxIterations; ++it) {
             const Eigen::Vector3d p = next(r.p);
             const double change = (p - r.p).norm();

@@ -153,8 +153,7 @@ bool SweepSegment::identityOn(const Box& box) const {
 
 Eigen::Vector3d SweepSegment::inverseStep(int k, const Eigen::Vector3d& p) const {
     if (tools_.size() != 1) return StepDeformation::inverseStep(k, p);
-    const double phi = oneToolInfluence(k, p);
-    return phi == 0.0 ? p : tools_[0].stepLog.applyExp(-phi, p); // 5.18
+    return oneToolStep(-oneToolInfluence(k, p), p);
 }
 
 void SweepSegment::inverseMaps(const Eigen::Vector3d* p, std::size_t n,
@@ -173,8 +172,7 @@ void SweepSegment::inverseMaps(const Eigen::Vector3d* p, std::size_t n,
     for (int k = steps_ - 1; k >= 0; --k) {
         influencesInBox(k, moved, out, box);
         for (std::size_t j = 0; j < box.index.size(); ++j)
-            if (box.phi[j] != 0.0) // 5.18
-                out[box.index[j]] = tools_[0].stepLog.applyExp(-box.phi[j], box.points[j]);
+            out[box.index[j]] = oneToolStep(-box.phi[j], box.points[j]);
     }
 }
 
@@ -196,8 +194,7 @@ ForwardResult SweepSegment::forwardStep(int k, const Eigen::Vector3d& q, double 
     if (tools_.size() != 1) return StepDeformation::forwardStep(k, q, tolerance);
     // p = exp(phi(p) L) q, iterated (INVERTFASTER, 5.4.1).
     return iterateForward(q, tolerance, forwardMaxIterations_, [&](const Eigen::Vector3d& p) {
-        const double phi = oneToolInfluence(k, p);
-        return phi == 0.0 ? q : tools_[0].stepLog.applyExp(phi, q);
+        return oneToolStep(oneToolInfluence(k, p), q);
     });
 }
 
@@ -210,13 +207,12 @@ void SweepSegment::forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, 
     thread_local std::vector<std::size_t> iterating;
     thread_local std::vector<double> tol;
     thread_local InBox box;
-    const double relative = tolerance > 0.0 ? tolerance : forwardTolerance_;
     iterating.resize(n);
     tol.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
         out[i] = q[i];
         iterating[i] = i;
-        tol[i] = relative * (1.0 + q[i].norm());
+        tol[i] = forwardToleranceAt(q[i], tolerance);
     }
     for (int it = 1; it <= forwardMaxIterations_ && !iterating.empty(); ++it) {
         influencesInBox(k, iterating, out, box);
@@ -225,7 +221,7 @@ void SweepSegment::forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, 
         for (const std::size_t i : iterating) {
             double w = 0.0;
             if (j < box.index.size() && box.index[j] == i) w = box.phi[j++];
-            const Eigen::Vector3d next = w == 0.0 ? q[i] : tools_[0].stepLog.applyExp(w, q[i]);
+            const Eigen::Vector3d next = oneToolStep(w, q[i]);
             const double change = (next - out[i]).norm();
             out[i] = next;
             if (change > tol[i]) iterating[kept++] = i;

@@ -91,6 +91,12 @@ class SweepSegment : public StepDeformation {
                    : 0.0;
     }
 
+    // exp(w L) p for the one tool's sub-step log L (5.18: w = -phi inverts a sub-step, w = phi
+    // iterates it forward), and p itself where w is 0, to the bit.
+    Eigen::Vector3d oneToolStep(double w, const Eigen::Vector3d& p) const {
+        return w == 0.0 ? p : tools_[0].stepLog.applyExp(w, p);
+    }
+
     // The points at[i], i in `which` (in order), that lie in sub-step k's box, and the one
     // tool's influence there (influence, to the bit): what the batched maps gather.
     struct InBox {
