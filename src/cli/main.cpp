@@ -1,6 +1,9 @@
 // sweepers-cli: the command-line front end. Every failure prints one line on stderr,
-// exits non-zero and leaves no output file behind.
+// exits non-zero and leaves no output file behind. The exit codes (docs/cli.md): 0 done,
+// 1 input refused or the work failed, 2 a usage error, 3 a study that finished with runs
+// failed (or without its plots), 130 interrupted.
 #include <algorithm>
+#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -16,6 +19,7 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include "cli/progress.h"
 #include "core/memory.h"
 #include "io/atomic_file.h"
 #include "io/film_files.h"
@@ -34,7 +38,33 @@
 namespace {
 
 using namespace sweepers;
+using cli::ProgressLine;
+using cli::ProgressMode;
 using nlohmann::json;
+
+enum ExitCode : int { kDone = 0, kFailed = 1, kUsage = 2, kPartlyDone = 3, kInterrupted = 130 };
+
+// An option's value that makes no sense (a negative voxel size, a frame range that is not
+// one): a usage error, as CLI11's own are, not a refusal of the user's input files.
+struct UsageError : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+// What every command shares: -q (nothing on stderr but errors) and --json (one JSON object
+// on stdout, for scripts that drive the command).
+struct Output {
+    bool quiet = false, json = false;
+    ProgressMode progress() const { return cli::progressModeFor(quiet); }
+    // A line for the user on stderr, unless -q.
+    void say(const std::string& line) const {
+        if (!quiet) std::fprintf(stderr, "%s\n", line.c_str());
+    }
+};
+Output gOut;
+
+void printJson(const json& j) {
+    std::cout << j.dump(2) << "\n";
+}
 
 // Ctrl-C (SIGINT) or SIGTERM stops long work at the next leaf range: the handler only sets
 // a flag, the engine throws Cancelled, and no output has been written yet.
@@ -55,7 +85,7 @@ void requireWritable(const std::string& path) {
                                  " is not a writable directory)");
 }
 
-int runCheck(const std::string& path, bool asJson) {
+int runCheck(const std::string& path) {
     const StrokeScript script = readStrokeScript(path);
     requireBuildableStart(script); // the limits apply holds the script to
     json out = json::array();
@@ -125,9 +155,14 @@ int runCheck(const std::string& path, bool asJson) {
             }
         }
     }
-    if (asJson) {
-        std::cout << out.dump(2) << "\n";
-        return 0;
+    if (gOut.json) {
+        printJson({{"script", path},
+                   {"valid", true},
+                   {"strokes", script.strokes.size()},
+                   {"voxel_size", script.grid.voxelSize},
+                   {"half_width", script.grid.halfWidth},
+                   {"deformations", out}});
+        return kDone;
     }
     std::cout << path << ": valid, " << script.strokes.size() << " strokes\n";
     for (const auto& row : out) {
@@ -181,12 +216,12 @@ json infoJson(const LevelSetMeasures& m) {
 GridPtr readChosenLevelSet(const std::string& path, const std::string& gridName) {
     const LevelSetFile file = readLevelSetFile(path, gridName);
     if (gridName.empty() && file.levelSets > 1)
-        std::fprintf(stderr, "%s holds %zu level sets; using '%s' (choose with --grid NAME)\n",
-                     path.c_str(), file.levelSets, file.name.c_str());
+        gOut.say(path + " holds " + std::to_string(file.levelSets) + " level sets; using '" +
+                 file.name + "' (choose with --grid NAME)");
     return file.grid;
 }
 
-int runInfo(const std::string& path, const std::string& gridName, bool asJson) {
+int runInfo(const std::string& path, const std::string& gridName) {
     const LevelSetFile file = readLevelSetFile(path, gridName);
     const GridPtr grid = file.grid;
     const LevelSetMeasures m = measureLevelSet(*grid);
@@ -194,8 +229,9 @@ int runInfo(const std::string& path, const std::string& gridName, bool asJson) {
     // LevelSetMeasure's smeared integrals drift by a few tenths of a percent.
     const TriangleMesh mesh = meshLevelSet(*grid);
     const double meshVolume = enclosedVolume(mesh);
-    if (asJson) {
+    if (gOut.json) {
         json j = infoJson(m);
+        j["file"] = path;
         j["grid"] = file.name;
         j["grids_in_file"] = file.grids;
         j["mesh_volume"] = meshVolume;
@@ -228,8 +264,32 @@ int runInfo(const std::string& path, const std::string& gridName, bool asJson) {
 }
 
 void reportMeshWritten(const std::string& path, const TriangleMesh& mesh) {
-    std::fprintf(stderr, "wrote %s: %zu vertices, %zu triangles\n", path.c_str(),
-                 mesh.positions.size(), mesh.triangles.size());
+    gOut.say("wrote " + path + ": " + std::to_string(mesh.positions.size()) + " vertices, " +
+             std::to_string(mesh.triangles.size()) + " triangles");
+}
+
+json meshJson(const std::string& path, const TriangleMesh& mesh) {
+    return {
+        {"path", path}, {"vertices", mesh.positions.size()}, {"triangles", mesh.triangles.size()}};
+}
+
+// The measures a --json report gives of a grid written: volume, area and topology.
+json measuresJson(const Grid& grid) {
+    const LevelSetMeasures m = measureLevelSet(grid);
+    return {{"voxel_size", m.voxelSize},
+            {"active_voxels", m.activeVoxels},
+            {"volume", m.volume},
+            {"area", m.area},
+            {"topology",
+             {{"euler_characteristic", m.eulerCharacteristic},
+              {"genus", m.genus},
+              {"components", m.components}}}};
+}
+
+// --voxel-size as given: 0 (not given) or a positive finite number.
+void requireVoxelSizeOption(double h) {
+    if (h != 0.0 && !(h > 0.0 && std::isfinite(h)))
+        throw UsageError("--voxel-size must be a positive number");
 }
 
 // The surface as exported: y up as the modeler shows it, or turned so that z is up.
@@ -247,14 +307,12 @@ void exportMesh(const Grid& grid, const std::string& path, const std::string& up
 struct ApplyArgs {
     std::string script, output, mesh, up = "y";
     double voxelSize = 0.0;
-    bool perSubStep = false, quiet = false, firstOrder = false, stats = false, cubic = false,
-         force = false;
+    bool perSubStep = false, firstOrder = false, stats = false, cubic = false, force = false;
 };
 
 int runApply(const ApplyArgs& a) {
+    requireVoxelSizeOption(a.voxelSize);
     const StrokeScript script = readStrokeScript(a.script);
-    if (a.voxelSize != 0.0 && !(a.voxelSize > 0.0 && std::isfinite(a.voxelSize)))
-        throw std::runtime_error("--voxel-size must be a positive number");
     if (!a.mesh.empty()) requireMeshPath(a.mesh);
     requireWritable(a.output);
     if (!a.mesh.empty()) requireWritable(a.mesh);
@@ -267,18 +325,21 @@ int runApply(const ApplyArgs& a) {
     Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop, a.force),
                       options);
     const Grid& grid = sculptor.grid();
-    // The volumes are only for the closing line (each walks the whole band: at 1/128 the two
-    // took 727M of the 23.8G instructions applying data/drag.json on one thread).
-    const double before = a.quiet ? 0.0 : levelSetVolume(grid);
+    // The volumes are only for the closing line and the report, and each walks the whole
+    // band, which on one thread is a noticeable share of a short script: skipped when
+    // nothing will show them.
+    const bool report = !gOut.quiet || gOut.json;
+    const double before = report ? levelSetVolume(grid) : 0.0;
     if (a.stats) sculptor.startMeshing();
     const double meshBefore = a.stats ? sculptor.mesher().enclosedVolume() : 0.0;
-    const auto reports =
-        applyStrokes(sculptor, script.strokes, [&](std::size_t done, std::size_t all) {
-            if (!a.quiet)
-                std::fprintf(stderr, "\rapplying %s: segment %zu / %zu", a.script.c_str(), done,
-                             all);
+    const auto wallStart = std::chrono::steady_clock::now();
+    std::vector<SegmentReport> reports;
+    {
+        ProgressLine progress(gOut.progress(), "applying " + a.script, "segment");
+        reports = applyStrokes(sculptor, script.strokes, [&](std::size_t done, std::size_t all) {
+            progress.update(done, all);
         });
-    if (!a.quiet && !reports.empty()) std::fprintf(stderr, "\n");
+    }
     pollInterrupt(&gStop);
     if (a.stats) {
         std::fprintf(stderr, "mesh volume before: %.7f\n", meshBefore);
@@ -312,16 +373,34 @@ int runApply(const ApplyArgs& a) {
     }
     vdb.commit();
     if (meshFile) meshFile->commit();
-    if (!a.quiet) {
-        const double after = levelSetVolume(grid);
-        std::fprintf(stderr,
-                     "wrote %s: %zu segments (band growth %.3f s, sampling %.3f s, "
-                     "renormalization %.3f s), volume %.6g -> %.6g (%+.3f%%)\n",
-                     a.output.c_str(), reports.size(), grow, adv, ren, before, after,
-                     100.0 * (after - before) / before);
-    }
+    const double wall =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    const double after = report ? levelSetVolume(grid) : 0.0;
+    char line[256];
+    std::snprintf(line, sizeof line,
+                  ": %zu segments (band growth %.3f s, sampling %.3f s, "
+                  "renormalization %.3f s), volume %.6g -> %.6g (%+.3f%%)",
+                  reports.size(), grow, adv, ren, before, after, 100.0 * (after - before) / before);
+    gOut.say("wrote " + a.output + line);
     if (meshFile) reportMeshWritten(a.mesh, mesh);
-    return 0;
+    if (gOut.json) {
+        json j = measuresJson(grid);
+        j["script"] = a.script;
+        j["output"] = a.output;
+        j["mesh"] = meshFile ? meshJson(a.mesh, mesh) : json(nullptr);
+        j["segments"] = reports.size();
+        j["volume_before"] = before;
+        j["volume_change_pct"] = 100.0 * (after - before) / before;
+        j["timings"] = {{"wall_s", wall},
+                        {"band_growth_s", grow},
+                        {"sampling_s", adv},
+                        {"renormalization_s", ren}};
+        json files = json::array({a.output});
+        if (meshFile) files.push_back(a.mesh);
+        j["files"] = files;
+        printJson(j);
+    }
+    return kDone;
 }
 
 // Rebuilds the document of a modeler session that ended in a crash, as the modeler's
@@ -346,13 +425,13 @@ int runRecover(const std::string& where, const std::string& output, const std::s
     }
     vdb.commit();
     if (scriptFile) scriptFile->commit();
-    std::fprintf(stderr, "%s: %s\n", dir.c_str(), describeRecovery(state, start).c_str());
-    return 0;
+    gOut.say(dir + ": " + describeRecovery(state, start));
+    return kDone;
 }
 
 struct StudyArgs {
     std::string script, dir, voxelSizes = "1/32,1/64,1/128,1/256", variants = "trilinear";
-    bool quiet = false, force = false;
+    bool force = false;
 };
 
 // "1/32,1/64,0.01": voxel sizes as decimals or 1/N, coarsest first.
@@ -370,17 +449,16 @@ std::vector<double> parseVoxelSizes(const std::string& list) {
         try {
             v = std::stod(digits, &used);
         } catch (const std::exception&) {
-            throw std::runtime_error(bad);
+            throw UsageError(bad);
         }
-        if (used != digits.size() || !std::isfinite(v)) throw std::runtime_error(bad);
-        if (v <= 0.0)
-            throw std::runtime_error("--voxel-sizes: '" + item + "' is not a positive size");
+        if (used != digits.size() || !std::isfinite(v)) throw UsageError(bad);
+        if (v <= 0.0) throw UsageError("--voxel-sizes: '" + item + "' is not a positive size");
         const double h = fraction ? 1.0 / v : v;
         if (std::find(sizes.begin(), sizes.end(), h) != sizes.end())
-            throw std::runtime_error("--voxel-sizes: '" + item + "' is given twice");
+            throw UsageError("--voxel-sizes: '" + item + "' is given twice");
         sizes.push_back(h);
     }
-    if (sizes.empty()) throw std::runtime_error("--voxel-sizes: no voxel size given");
+    if (sizes.empty()) throw UsageError("--voxel-sizes: no voxel size given");
     std::sort(sizes.begin(), sizes.end(), std::greater<>());
     return sizes;
 }
@@ -392,11 +470,11 @@ std::vector<StudyVariant> parseVariants(const std::string& list) {
     while (std::getline(in, item, ',')) {
         const auto v = parseVariant(item);
         if (!v)
-            throw std::runtime_error("--variants: unknown variant '" + item +
-                                     "' (trilinear, cubic, per-substep, first-order)");
+            throw UsageError("--variants: unknown variant '" + item +
+                             "' (trilinear, cubic, per-substep, first-order)");
         if (std::find(out.begin(), out.end(), *v) == out.end()) out.push_back(*v);
     }
-    if (out.empty()) throw std::runtime_error("--variants: no variant given");
+    if (out.empty()) throw UsageError("--variants: no variant given");
     return out;
 }
 
@@ -404,9 +482,9 @@ std::vector<StudyVariant> parseVariants(const std::string& list) {
 // the exact reference of its history. Each finished run is saved (its grid, mesh and row)
 // before the next starts, so an interrupted study resumes where it stopped.
 int runStudy(const StudyArgs& a) {
-    const StrokeScript script = readStrokeScript(a.script);
     const std::vector<double> sizes = parseVoxelSizes(a.voxelSizes);
     const std::vector<StudyVariant> variants = parseVariants(a.variants);
+    const StrokeScript script = readStrokeScript(a.script);
     for (const double h : sizes)
         requireBuildableStart(script, h, a.force); // the limits apply holds the script to
     std::error_code ec;
@@ -421,6 +499,11 @@ int runStudy(const StudyArgs& a) {
     std::vector<StudyRow> rows;
     const std::size_t total = sizes.size() * variants.size();
     std::size_t reused = 0;
+    json files = json::array();
+    // A line per finished run wherever stderr goes; the segments of the run in progress only
+    // as a bar on a terminal.
+    ProgressLine progress(gOut.progress(), "study", "run");
+    progress.setLinesEachTenth(false);
     for (const double h : sizes)
         for (const StudyVariant v : variants) {
             StudyRow planned;
@@ -428,15 +511,24 @@ int runStudy(const StudyArgs& a) {
             planned.voxelSize = h;
             const std::string name = studyRunName(planned);
             const std::string vdbPath = a.dir + "/" + name + ".vdb";
+            const std::string plyPath = a.dir + "/" + name + ".ply";
+            const std::size_t k = rows.size() + 1;
+            const std::string which = "study: run " + std::to_string(k) + " / " +
+                                      std::to_string(total) + " (" + name + ")";
             const auto done = std::find_if(earlier.begin(), earlier.end(), [&](const StudyRow& r) {
                 return r.variant == planned.variant && r.voxelSize == h && r.failure.empty();
             });
             if (done != earlier.end() && std::filesystem::exists(vdbPath)) {
                 rows.push_back(*done);
                 ++reused;
+                files.push_back(vdbPath);
+                files.push_back(plyPath);
+                progress.print(which + ": kept from before");
                 continue;
             }
-            const std::size_t k = rows.size() + 1;
+            ProgressLine segments(progress.mode() == ProgressMode::Terminal ? ProgressMode::Terminal
+                                                                            : ProgressMode::Quiet,
+                                  which, "segment");
             try {
                 const GridPtr start =
                     makeStartGrid(script, directoryOf(a.script), h, &gStop, a.force);
@@ -444,33 +536,38 @@ int runStudy(const StudyArgs& a) {
                     script.start.kind == StartShape::Kind::Sphere
                         ? ExactReference::sphere(script.start.center, script.start.radius)
                         : ExactReference::sampled(start->deepCopy());
-                StudyRun run = runStudyCase(
-                    start, script.strokes, shape, v, &gStop, [&](std::size_t i, std::size_t n) {
-                        if (!a.quiet)
-                            std::fprintf(stderr, "\rstudy: run %zu / %zu (%s): segment %zu / %zu ",
-                                         k, total, name.c_str(), i, n);
-                    });
+                StudyRun run =
+                    runStudyCase(start, script.strokes, shape, v, &gStop,
+                                 [&](std::size_t i, std::size_t n) { segments.update(i, n); });
                 AtomicWrite vdb = prepareLevelSet(*run.grid, vdbPath);
-                AtomicWrite mesh = prepareMesh(run.mesh, a.dir + "/" + name + ".ply");
+                AtomicWrite mesh = prepareMesh(run.mesh, plyPath);
                 vdb.commit();
                 mesh.commit();
                 rows.push_back(run.row);
+                files.push_back(vdbPath);
+                files.push_back(plyPath);
+                segments.finish();
+                char line[96];
+                std::snprintf(line, sizeof line, ": done in %.2f s, RMS error %.3g voxels",
+                              run.row.wallSeconds, run.row.error.rms / h);
+                progress.print(which + line);
             } catch (const Cancelled&) {
                 // The finished runs are on disk already: say so, rather than "nothing was
                 // written".
                 writeTextAtomically(csv, studyCsv(rows));
-                if (!a.quiet) std::fprintf(stderr, "\n"); // ends the progress line
+                segments.finish();
                 std::fprintf(stderr,
                              "sweepers-cli: interrupted after %zu of %zu runs; they are in %s "
                              "(the same command resumes the study)\n",
                              rows.size(), total, csv.c_str());
-                return 130;
+                return kInterrupted;
             } catch (const std::exception& e) {
                 // One failed run is reported in its row; the others still run.
                 planned.failure = e.what();
                 rows.push_back(planned);
+                segments.finish();
+                progress.print(which + ": failed: " + planned.failure);
             }
-            if (!a.quiet) std::fprintf(stderr, "\n");
             fillOrders(rows);
             writeTextAtomically(csv, studyCsv(rows));
         }
@@ -478,24 +575,52 @@ int runStudy(const StudyArgs& a) {
     writeTextAtomically(csv, studyCsv(rows));
     writeTextAtomically(report, studyReport(rows, a.script));
     std::size_t failed = 0;
+    json failedRuns = json::array();
     for (const StudyRow& r : rows)
-        failed += !r.failure.empty();
-    std::fprintf(stderr, "wrote %s and %s: %zu runs (%zu reused from before, %zu failed)\n",
-                 csv.c_str(), report.c_str(), rows.size(), reused, failed);
+        if (!r.failure.empty()) {
+            ++failed;
+            failedRuns.push_back(studyRunName(r));
+        }
+    gOut.say("wrote " + csv + " and " + report + ": " + std::to_string(rows.size()) + " runs (" +
+             std::to_string(reused) + " reused from before, " + std::to_string(failed) +
+             " failed)");
     // The table stands without the plots: a plot that cannot be drawn is said, not fatal to it.
+    std::string plotsError;
     try {
         writeStudyPlots(rows, a.dir, a.script);
+        for (const char* f : {"convergence.gp", "convergence.png", "convergence.svg"})
+            files.push_back(a.dir + "/" + f);
     } catch (const std::exception& e) {
+        plotsError = e.what();
         std::fprintf(stderr, "sweepers-cli: %s\n", e.what());
-        return 1;
     }
-    return failed == 0 ? 0 : 1;
+    if (failed > 0) {
+        std::string names;
+        for (const auto& n : failedRuns)
+            names += (names.empty() ? "" : ", ") + n.get<std::string>();
+        std::fprintf(stderr, "sweepers-cli: %zu of %zu runs failed (%s); see %s\n", failed,
+                     rows.size(), names.c_str(), report.c_str());
+    }
+    if (gOut.json) {
+        files.push_back(csv);
+        files.push_back(report);
+        printJson({{"script", a.script},
+                   {"dir", a.dir},
+                   {"csv", csv},
+                   {"report", report},
+                   {"runs", studyJson(rows)},
+                   {"reused", reused},
+                   {"failed", failedRuns},
+                   {"plots_error", plotsError.empty() ? json(nullptr) : json(plotsError)},
+                   {"files", files}});
+    }
+    return failed == 0 && plotsError.empty() ? kDone : kPartlyDone;
 }
 
 struct AnimateArgs {
     std::string script, output, mesh, frames, fog, up = "y";
     double fps = 24.0, secondsPerSegment = 0.25, voxelSize = 0.0;
-    bool quiet = false, force = false;
+    bool force = false;
 };
 
 // "A-B" or "A", within 1..count.
@@ -514,10 +639,10 @@ std::pair<std::size_t, std::size_t> parseFrameRange(const std::string& text, std
             if (used + 1 + more != text.size()) throw std::invalid_argument("");
         }
     } catch (const std::exception&) {
-        throw std::runtime_error("--frames: '" + text + "' is not a frame range such as " + all);
+        throw UsageError("--frames: '" + text + "' is not a frame range such as " + all);
     }
     if (a < 1 || a > b || b > count)
-        throw std::runtime_error("--frames: " + text + " is not within the film's frames " + all);
+        throw UsageError("--frames: " + text + " is not within the film's frames " + all);
     return {a, b};
 }
 
@@ -526,10 +651,9 @@ std::pair<std::size_t, std::size_t> parseFrameRange(const std::string& text, std
 // at the same time, frame rate and voxel size is kept, so an edit rewrites only the frames
 // it changes.
 int runAnimate(const AnimateArgs& a) {
+    requireVoxelSizeOption(a.voxelSize);
     std::string text; // the script as parsed: what the frames are made of
     const StrokeScript script = readStrokeScript(a.script, &text);
-    if (a.voxelSize != 0.0 && !(a.voxelSize > 0.0 && std::isfinite(a.voxelSize)))
-        throw std::runtime_error("--voxel-size must be a positive number");
     FilmTiming timing;
     timing.fps = a.fps;
     timing.secondsPerSegment = a.secondsPerSegment;
@@ -584,7 +708,10 @@ int runAnimate(const AnimateArgs& a) {
         kept[n] = a.mesh.empty() || std::filesystem::exists(framePath(a.mesh, n));
         keptCount += kept[n];
     }
+    std::size_t written = 0;
+    json files = json::array();
     try {
+        ProgressLine progress(gOut.progress(), "animating " + a.script, "frame");
         playFilm(
             sculptor, script, timing, first, last,
             [&](std::size_t n, double, const Grid& grid) {
@@ -594,26 +721,37 @@ int runAnimate(const AnimateArgs& a) {
                     meshFile.emplace(prepareMesh(exportedMesh(grid, a.up), framePath(a.mesh, n)));
                 vdb.commit();
                 if (meshFile) meshFile->commit();
+                ++written;
             },
             [&](std::size_t n) { return !kept[n]; },
-            [&](std::size_t done, std::size_t) {
-                if (!a.quiet)
-                    std::fprintf(stderr, "\ranimating %s: frame %zu / %zu", a.script.c_str(),
-                                 first + done - 1, last);
-            });
+            [&](std::size_t done, std::size_t all) { progress.update(done, all); });
     } catch (const Cancelled&) {
-        if (!a.quiet) std::fprintf(stderr, "\n");
         std::fprintf(stderr,
                      "sweepers-cli: interrupted; the frames written are kept (the same command "
                      "resumes the film)\n");
-        return 130;
+        return kInterrupted;
     }
-    if (!a.quiet)
-        std::fprintf(stderr, "\nwrote frames %zu-%zu of %zu (%.4g s at %.4g fps) to %s%s\n", first,
-                     last, count, seconds, timing.fps, a.output.c_str(),
-                     keptCount ? (", " + std::to_string(keptCount) + " kept from before").c_str()
-                               : "");
-    return 0;
+    char line[160];
+    std::snprintf(line, sizeof line, "wrote frames %zu-%zu of %zu (%.4g s at %.4g fps) to ", first,
+                  last, count, seconds, timing.fps);
+    gOut.say(line + a.output +
+             (keptCount ? ", " + std::to_string(keptCount) + " kept from before" : ""));
+    if (gOut.json) {
+        for (std::size_t n = first; n <= last; ++n) {
+            files.push_back(framePath(a.output, n));
+            if (!a.mesh.empty()) files.push_back(framePath(a.mesh, n));
+        }
+        printJson({{"script", a.script},
+                   {"frames", {{"first", first}, {"last", last}, {"count", count}}},
+                   {"fps", timing.fps},
+                   {"seconds", seconds},
+                   {"voxel_size", h},
+                   {"written", written},
+                   {"kept", keptCount},
+                   {"fog", a.fog.empty() ? json(nullptr) : json(a.fog)},
+                   {"files", files}});
+    }
+    return kDone;
 }
 } // namespace
 
@@ -625,11 +763,19 @@ static int run(int argc, char** argv) {
     app.add_option("--threads", threads, "Worker threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
 
+    // -q and --json: on the program and on each command, wherever the user puts them.
+    const auto quietFlag = [](CLI::App* on) {
+        on->add_flag("-q,--quiet", gOut.quiet, "Print nothing but errors");
+    };
+    const auto jsonFlag = [](CLI::App* on, const std::string& what) {
+        on->add_flag("--json", gOut.json, "Print " + what + " as one JSON object on stdout");
+    };
+    quietFlag(&app);
+
     std::string path, output;
-    bool asJson = false;
     CLI::App* check = app.add_subcommand("check", "Validate a stroke script and show its plan");
     check->add_option("script", path, "Stroke script (JSON)")->required();
-    check->add_flag("--json", asJson, "Print the plan as JSON");
+    jsonFlag(check, "the plan");
 
     double radius = 1.0, voxelSize = 0.02, halfWidth = 3.0;
     std::vector<double> center{0, 0, 0};
@@ -660,7 +806,7 @@ static int run(int argc, char** argv) {
     apply->add_flag("--first-order", applyArgs.firstOrder, "First-order fast marching");
     apply->add_flag("--monotone-cubic", applyArgs.cubic,
                     "Resample with the monotone cubic of appendix C.1 instead of trilinear");
-    apply->add_flag("-q,--quiet", applyArgs.quiet, "No progress output");
+    jsonFlag(apply, "what was measured and written");
     apply->add_flag("--force", applyArgs.force,
                     "Build the start shape even when it seems to need more memory than is free");
     apply->add_flag("--stats", applyArgs.stats,
@@ -671,7 +817,7 @@ static int run(int argc, char** argv) {
 
     CLI::App* info = app.add_subcommand("info", "Describe a level-set VDB file");
     info->add_option("file", path, "Level-set .vdb")->required();
-    info->add_flag("--json", asJson, "Print as JSON");
+    jsonFlag(info, "the description");
     std::string gridName;
     info->add_option("--grid", gridName,
                      "The level set to describe, by name (default: the first usable one)");
@@ -706,7 +852,7 @@ static int run(int argc, char** argv) {
                       "Voxel sizes, decimals or 1/N (default 1/32,1/64,1/128,1/256)");
     study->add_option("--variants", studyArgs.variants,
                       "trilinear, cubic, per-substep, first-order (default trilinear)");
-    study->add_flag("-q,--quiet", studyArgs.quiet, "No progress output");
+    jsonFlag(study, "every run's row and the files written");
     study->add_flag("--force", studyArgs.force,
                     "Build start shapes even when they seem to need more memory than is free");
     study->add_option("--threads", threads, "Worker threads")->check(CLI::Range(1, 1024));
@@ -738,16 +884,20 @@ static int run(int argc, char** argv) {
         ->expected(0, 1)
         ->default_str("density");
     animate->add_option("--voxel-size", animateArgs.voxelSize, "Override the script's voxel size");
-    animate->add_flag("-q,--quiet", animateArgs.quiet, "No progress output");
+    jsonFlag(animate, "the frames and files written");
     animate->add_flag("--force", animateArgs.force,
                       "Overwrite frames of another film; build the start even when it seems to "
                       "need more memory than is free");
     animate->add_option("--threads", threads, "Worker threads")->check(CLI::Range(1, 1024));
 
+    for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; }))
+        quietFlag(command);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e);
+        // --help and --version are not errors; anything else CLI11 refuses is a usage error.
+        const int code = app.exit(e);
+        return code == 0 ? kDone : kUsage;
     }
     std::signal(SIGINT, onStopSignal);
     std::signal(SIGTERM, onStopSignal);
@@ -756,8 +906,8 @@ static int run(int argc, char** argv) {
         limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                       std::size_t(threads));
     try {
-        if (*check) return runCheck(path, asJson);
-        if (*info) return runInfo(path, gridName, asJson);
+        if (*check) return runCheck(path);
+        if (*info) return runInfo(path, gridName);
         if (*apply) return runApply(applyArgs);
         if (*recover) return runRecover(path, output, scriptOut);
         if (*study) return runStudy(studyArgs);
@@ -770,22 +920,25 @@ static int run(int argc, char** argv) {
             const GridPtr g =
                 makeSphere({center[0], center[1], center[2]}, radius, voxelSize, halfWidth);
             writeLevelSet(*g, output);
-            return 0;
+            return kDone;
         }
         if (*mesh) {
             requireMeshPath(output);
             requireWritable(output);
             exportMesh(*readChosenLevelSet(path, gridName), output, up);
-            return 0;
+            return kDone;
         }
     } catch (const Cancelled&) {
         std::cerr << "sweepers-cli: interrupted; nothing was written\n";
-        return 130; // the shell's code for a command ended by SIGINT
+        return kInterrupted; // the shell's code for a command ended by SIGINT
+    } catch (const UsageError& e) {
+        std::cerr << "sweepers-cli: " << e.what() << "\n";
+        return kUsage;
     } catch (const std::exception& e) {
         std::cerr << "sweepers-cli: " << e.what() << "\n";
-        return 1;
+        return kFailed;
     }
-    return 0;
+    return kDone;
 }
 
 int main(int argc, char** argv) {
@@ -795,6 +948,6 @@ int main(int argc, char** argv) {
         return run(argc, argv);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "sweepers-cli: %s\n", e.what());
-        return 1;
+        return kFailed;
     }
 }

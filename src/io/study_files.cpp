@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <set>
 #include <sstream>
@@ -117,21 +118,41 @@ std::string quoted(const std::string& s) {
     return out + "\"";
 }
 
+// The first line gnuplot wrote to `fd` (a file it wrote its warnings and errors to), for a
+// failure's message; empty when it wrote none.
+std::string firstLineOf(int fd) {
+    std::string text(512, '\0');
+    const ssize_t n = ::pread(fd, text.data(), text.size(), 0);
+    text.resize(n > 0 ? std::size_t(n) : 0);
+    return text.substr(0, text.find('\n'));
+}
+
 // Runs gnuplot on `script` in `dir` with `terminal` set first; returns what it drew (its
-// standard output).
+// standard output). Its warnings go to a file of its own, not to the user's terminal: a
+// study that draws its plots says nothing of how they were drawn, and one that cannot
+// draw them says why in its one line.
 std::string runGnuplot(const std::string& dir, const std::string& script,
                        const std::string& terminal) {
     // Built before the fork: the child of a threaded process may not allocate.
     const std::string set = "set terminal " + terminal;
+    std::string logName = (std::filesystem::temp_directory_path() / "sweepers-gnuplot-XXXXXX");
+    const int log = ::mkstemp(logName.data());
+    if (log < 0) throw std::runtime_error("plots: cannot start gnuplot (temporary file)");
+    ::unlink(logName.c_str()); // an anonymous file: nothing is left behind, whatever happens
     int out[2];
-    if (::pipe(out) != 0) throw std::runtime_error("plots: cannot start gnuplot (pipe)");
+    if (::pipe(out) != 0) {
+        ::close(log);
+        throw std::runtime_error("plots: cannot start gnuplot (pipe)");
+    }
     const pid_t pid = ::fork();
     if (pid < 0) {
         ::close(out[0]);
         ::close(out[1]);
+        ::close(log);
         throw std::runtime_error("plots: cannot start gnuplot (fork)");
     }
     if (pid == 0) {
+        ::dup2(log, STDERR_FILENO);
         ::dup2(out[1], STDOUT_FILENO);
         ::close(out[0]);
         ::close(out[1]);
@@ -156,10 +177,13 @@ std::string runGnuplot(const std::string& dir, const std::string& script,
     int status = 0;
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
+    const std::string said = firstLineOf(log);
+    ::close(log);
     if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
         throw std::runtime_error("plots: gnuplot is not installed (Debian: gnuplot-nox)");
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || image.empty() || readFailed)
-        throw std::runtime_error("plots: gnuplot failed on " + dir + "/" + script);
+        throw std::runtime_error("plots: gnuplot failed on " + dir + "/" + script +
+                                 (said.empty() ? "" : " (" + said + ")"));
     return image;
 }
 
@@ -239,34 +263,86 @@ std::string studyRunName(const StudyRow& row) {
     return row.variant + "_" + number(row.voxelSize, 12);
 }
 
+namespace {
+
+// A row's cells in kColumns' order, as the table writes them: a failed run has only its
+// variant, voxel size and failure.
+std::vector<std::string> studyCells(const StudyRow& r) {
+    const bool ran = r.failure.empty();
+    const auto num = [&](double v, int digits = 7) { return ran ? number(v, digits) : ""; };
+    const auto count = [&](std::size_t v) { return ran ? std::to_string(v) : ""; };
+    const auto integer = [&](int v) { return ran ? std::to_string(v) : ""; };
+    // The exact topology's columns stay empty where it is not known.
+    const auto known = [&](const std::string& v) {
+        return r.referenceTopologyKnown ? v : std::string();
+    };
+    return {r.variant,
+            number(r.voxelSize, 17),
+            num(r.wallSeconds),
+            num(r.advectSeconds),
+            num(r.renormSeconds),
+            num(r.meshSeconds),
+            num(r.peakRssMb),
+            count(r.activeVoxels),
+            num(r.volume, 10),
+            num(r.volumeChangePct),
+            num(r.area, 10),
+            integer(r.euler),
+            integer(r.genus),
+            count(r.components),
+            num(r.error.mean),
+            num(r.error.rms),
+            num(r.error.max),
+            num(voxelsOf(r)),
+            count(r.error.signFlips),
+            num(r.orderRms, 4),
+            num(r.error.referenceVolume, 12),
+            num(r.error.volumeError(), 7),
+            num(r.orderVolume, 4),
+            known(integer(r.referenceEuler)),
+            known(integer(r.referenceGenus)),
+            known(count(r.referenceComponents)),
+            count(r.error.samples),
+            count(r.error.unmatched),
+            r.failure};
+}
+
+} // namespace
+
 std::string studyCsv(const std::vector<StudyRow>& rows) {
     std::ostringstream out;
     for (std::size_t c = 0; c < kColumnCount; ++c)
         out << (c ? "," : "") << kColumns[c];
     out << "\n";
     for (const StudyRow& r : rows) {
-        const bool ran = r.failure.empty();
-        const auto num = [&](double v, int digits = 7) { return ran ? number(v, digits) : ""; };
-        const auto count = [&](std::size_t v) { return ran ? std::to_string(v) : ""; };
-        const auto integer = [&](int v) { return ran ? std::to_string(v) : ""; };
-        // The exact topology's columns stay empty where it is not known.
-        const auto known = [&](const std::string& v) {
-            return r.referenceTopologyKnown ? v : std::string();
-        };
-        out << field(r.variant) << "," << number(r.voxelSize, 17) << "," << num(r.wallSeconds)
-            << "," << num(r.advectSeconds) << "," << num(r.renormSeconds) << ","
-            << num(r.meshSeconds) << "," << num(r.peakRssMb) << "," << count(r.activeVoxels) << ","
-            << num(r.volume, 10) << "," << num(r.volumeChangePct) << "," << num(r.area, 10) << ","
-            << integer(r.euler) << "," << integer(r.genus) << "," << count(r.components) << ","
-            << num(r.error.mean) << "," << num(r.error.rms) << "," << num(r.error.max) << ","
-            << num(voxelsOf(r)) << "," << count(r.error.signFlips) << "," << num(r.orderRms, 4)
-            << "," << num(r.error.referenceVolume, 12) << "," << num(r.error.volumeError(), 7)
-            << "," << num(r.orderVolume, 4) << "," << known(integer(r.referenceEuler)) << ","
-            << known(integer(r.referenceGenus)) << "," << known(count(r.referenceComponents)) << ","
-            << count(r.error.samples) << "," << count(r.error.unmatched) << "," << field(r.failure)
-            << "\n";
+        const std::vector<std::string> cells = studyCells(r);
+        for (std::size_t c = 0; c < kColumnCount; ++c)
+            out << (c ? "," : "") << field(cells[c]);
+        out << "\n";
     }
     return out.str();
+}
+
+nlohmann::json studyJson(const std::vector<StudyRow>& rows) {
+    nlohmann::json out = nlohmann::json::array();
+    for (const StudyRow& r : rows) {
+        const std::vector<std::string> cells = studyCells(r);
+        nlohmann::json row = nlohmann::json::object();
+        for (std::size_t c = 0; c < kColumnCount; ++c) {
+            const std::string& cell = cells[c];
+            const std::string_view name = kColumns[c];
+            if (name == "variant" || name == "failure")
+                row[kColumns[c]] = cell;
+            else if (cell.empty() || cell == "nan")
+                row[kColumns[c]] = nullptr; // not measured, or no coarser run to compare
+            else if (cell.find_first_of(".eEn") == std::string::npos)
+                row[kColumns[c]] = std::stoll(cell); // counts and topology stay whole
+            else
+                row[kColumns[c]] = std::stod(cell);
+        }
+        out.push_back(std::move(row));
+    }
+    return out;
 }
 
 std::vector<StudyRow> readStudyCsv(const std::string& path) {

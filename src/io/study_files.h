@@ -6,14 +6,20 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "study/study.h"
 
 namespace sweepers {
 
 // variant, voxel_size, wall_s, advect_s, renorm_s, mesh_s, peak_rss_mb, active_voxels,
 // volume, volume_change_pct, area, euler, genus, components, err_mean, err_rms, err_max,
-// err_rms_voxels, sign_flips, order_rms, err_samples, unmatched, failure
+// err_rms_voxels, sign_flips, order_rms, volume_ref, volume_err, order_volume, ref_euler,
+// ref_genus, ref_components, err_samples, unmatched, failure
 std::string studyCsv(const std::vector<StudyRow>& rows);
+// The same rows as JSON objects keyed by those columns: numbers as numbers, a cell the
+// table leaves empty (a failed run's measures, the coarsest run's order) as null.
+nlohmann::json studyJson(const std::vector<StudyRow>& rows);
 // Rows of a study.csv; a missing file has none. Throws FileError for a file that is not one.
 std::vector<StudyRow> readStudyCsv(const std::string& path);
 std::string studyReport(const std::vector<StudyRow>& rows, const std::string& script);

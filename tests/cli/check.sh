@@ -7,7 +7,9 @@
 grep -q "segment 0: 1 tool(s), 2 sub-steps" "$tmp/out" || { cat "$tmp/out"; exit 1; }
 "$cli" check --json "$data/pull.json" | /usr/bin/python3 -c '
 import json, sys
-plan = json.load(sys.stdin)
+report = json.load(sys.stdin)
+plan = report["deformations"]
+assert report["valid"] and report["strokes"] == 1, report
 assert len(plan) == 2 and all(p["steps"] == 2 for p in plan), plan'
 
 printf '{"sweepers": 1, "strokes": [{"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": -1, "path": []}]}]}' >"$tmp/bad.json"

@@ -147,7 +147,7 @@ done_rows=$(($(wc -l <"$tmp/killed/study.csv") - 1))
 stamp() { stat -c %y "$tmp/killed/trilinear_16.vdb" "$tmp/killed/trilinear_32.vdb"; }
 before=$(stamp)
 "$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/64 \
-  -q 2>"$tmp/err"
+  2>"$tmp/err"
 grep -q "3 runs ($done_rows reused from before, 0 failed)" "$tmp/err" ||
   fail "resume: $(cat "$tmp/err"), expected $done_rows reused"
 [ "$(stamp)" = "$before" ] || fail "a finished run was redone"
