@@ -17,6 +17,7 @@
 #include <memory>
 #include <optional>
 #include <ostream>
+#include <set>
 #include <stdexcept>
 
 #include <backends/imgui_impl_glfw.h>
@@ -47,6 +48,20 @@ namespace {
 // what other threads report.
 constexpr int kSettleFrames = 4;
 constexpr double kIdleWakeSeconds = 0.25;
+
+// The panel's width when it first opens; every label must fit in it (mustFit).
+constexpr float kPanelWidth = 380.0f;
+// The voxel sizes the panel offers as levels of detail (1/N).
+constexpr int kDetailLevels[] = {64, 128, 256, 512};
+// A mesh's bytes per triangle: three indices, and about half a vertex's position and normal.
+constexpr double kMeshBytesPerTriangle = 3 * 4 + 0.5 * 24;
+
+// "1/128" where the voxel size is one over a whole number, else the number.
+std::string detailName(double h) {
+    const double n = std::round(1.0 / h);
+    if (h > 0 && std::abs(1.0 / n - h) < 1e-9 * h) return "1/" + std::to_string(int(n));
+    return formatNumber(h);
+}
 
 // The window, its drawing and panels, and long jobs (open, import, resample) off the
 // render thread. What input does to the document and the camera is the controller's.
@@ -168,6 +183,9 @@ class Modeler {
         ctl_.wait();
         ctl_.step();
         doc_->endEdit();
+        for (const std::string& label : clipped_)
+            std::fprintf(stderr, "sweepers: the panel's '%s' does not fit its width\n",
+                         label.c_str());
         if (opt_.latencyReport) reportLatency();
         if (!opt_.latencyCsv.empty()) writeLatencyCsv(opt_.latencyCsv);
         if (!opt_.saveVdb.empty()) doc_->saveVdb(opt_.saveVdb);
@@ -522,8 +540,12 @@ class Modeler {
         // active voxels walks the whole tree: not at every wake of an idle window).
         if (changes.any() || doc_->undoCount() != info_.undoCount ||
             doc_->undoBytes() != info_.undoBytes)
-            info_ = {doc_->grid().voxelSize()[0], std::size_t(doc_->grid().activeVoxelCount()),
-                     doc_->mesher().triangleCount(), doc_->undoCount(), doc_->undoBytes()};
+            info_ = {doc_->grid().voxelSize()[0],
+                     std::size_t(doc_->grid().activeVoxelCount()),
+                     doc_->mesher().triangleCount(),
+                     doc_->undoCount(),
+                     doc_->undoBytes(),
+                     std::size_t(doc_->grid().memUsage())};
     }
 
     // Takes what the controller finished: a report to measure, or a message to show.
@@ -645,19 +667,64 @@ class Modeler {
         ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
     }
 
+    // An item whose right edge passes the panel's: its label is cut off. Reported once at
+    // exit, so that a test of the window at its default size sees it.
+    void mustFit(const char* what) {
+        const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
+        if (ImGui::GetItemRectMax().x > right + 0.5f) clipped_.insert(what);
+    }
+
+    // The memory a document of this shape needs at voxel size h: its band and its mesh both
+    // grow with the surface's area in voxels, so the figures now scale as (h_now / h)^2.
+    double memoryAtVoxelSize(double h) const {
+        const double now = info_.voxelSize > 0 ? info_.voxelSize : h;
+        const double bytes = double(info_.gridBytes) + kMeshBytesPerTriangle * info_.triangles;
+        return bytes * (now / h) * (now / h);
+    }
+
+    void resampleTo(double h) {
+        StrokeScript script = doc_->script();
+        const std::string dir = doc_->scriptDir();
+        doc_->endStroke();
+        if (!(h >= 1e-4 && h <= 0.5)) {
+            fail("the voxel size must lie between 0.0001 and 0.5");
+            return;
+        }
+        const bool modified = doc_->modified();
+        startJob("resampling to voxel size " + formatNumber(h),
+                 [script, dir, h, modified](const Progress& p, Interrupter* stop) {
+                     auto d =
+                         std::make_unique<Document>(Document::replayAt(script, dir, h, p, stop));
+                     if (modified) d->markModified();
+                     return d;
+                 });
+    }
+
     void mainPanel() {
         ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_FirstUseEver);
-        ImGui::SetNextWindowSize(ImVec2(380, 0), ImGuiCond_FirstUseEver);
+        ImGui::SetNextWindowSize(ImVec2(kPanelWidth, 0), ImGuiCond_FirstUseEver);
         ImGui::Begin("Sweepers");
+        // Sliders and fields leave room for the longest label beside them.
+        const ImGuiStyle& style = ImGui::GetStyle();
+        ImGui::PushItemWidth(-(ImGui::CalcTextSize("falloff  shift [ ]").x +
+                               style.ItemInnerSpacing.x + style.WindowPadding.x * 0.5f));
         ImGui::Text("Tool");
         ToolSettings& s = ctl_.settings();
         const bool sculpting = ctl_.drag() == DragKind::Sculpt;
         ImGui::BeginDisabled(sculpting);
         int m = int(s.mode);
+        const float right = ImGui::GetWindowPos().x + ImGui::GetWindowContentRegionMax().x;
         for (std::size_t k = 0; k < kModes.size(); ++k) {
-            // Three rows: the sweeps; swirl, fluid and clay; the topology tools.
-            if (k != 0 && k != 3 && k != 6) ImGui::SameLine();
+            // As many to a row as fit the panel's width: the sweeps first, then swirl,
+            // fluid and clay, then the topology tools.
+            if (k != 0) {
+                const float width = ImGui::GetFrameHeight() + style.ItemInnerSpacing.x +
+                                    ImGui::CalcTextSize(kModes[k].label).x;
+                ImGui::SameLine();
+                if (ImGui::GetCursorScreenPos().x + width > right) ImGui::NewLine();
+            }
             ImGui::RadioButton(kModes[k].label, &m, int(kModes[k].mode));
+            mustFit(kModes[k].label);
         }
         s.mode = SculptMode(m);
         ImGui::EndDisabled();
@@ -676,24 +743,16 @@ class Modeler {
         if (ImGui::SliderFloat("radius  [ ]", &r, 0.02f, 1.0f, "%.3f",
                                ImGuiSliderFlags_Logarithmic))
             s.radius = r;
+        mustFit("radius  [ ]");
         if (ImGui::SliderFloat("falloff  shift [ ]", &f, 0.02f, 1.0f, "%.3f",
                                ImGuiSliderFlags_Logarithmic))
             s.falloff = f;
+        mustFit("falloff  shift [ ]");
         int mirror = int(s.mirror);
         ImGui::Combo("mirror (M)", &mirror, "none\0x\0y\0z\0");
+        mustFit("mirror (M)");
         s.mirror = MirrorAxis(mirror);
         ImGui::Checkbox("wireframe (W)", &s.wireframe);
-        ImGui::Separator();
-        ImGui::Text("frame %.1f ms, upload %.1f ms", frameMs_, uploadMs_);
-        ImGui::Text("voxel size %.5g, active voxels %zu", info_.voxelSize, info_.activeVoxels);
-        ImGui::Text("triangles %zu, volume %.5f", info_.triangles, ctl_.volume());
-        const SegmentReport& last = finished_.report;
-        ImGui::Text("last segment: advect %.1f, renorm %.1f, mesh %.1f ms",
-                    1e3 * last.advectSeconds(), 1e3 * last.stats.renormalizeSeconds,
-                    1e3 * last.meshSeconds);
-        ImGui::Text("undo: %zu edits in %.1f of %.0f MB, %zu more by replay", info_.undoCount,
-                    double(info_.undoBytes) / (1 << 20), double(doc_->undoBudget()) / (1 << 20),
-                    doc_->droppedCount());
         // Nothing that changes the document while a drag is being sculpted, or while the
         // film of its history plays.
         ImGui::BeginDisabled(ctl_.busy() || sculpting || film_);
@@ -702,6 +761,7 @@ class Modeler {
         if (ImGui::Button("Redo")) onKey('Z', true, true);
         ImGui::SameLine();
         if (ImGui::Button("Film of the history (V)")) openFilm();
+        mustFit("Film of the history (V)");
         ImGui::Separator();
         ImGui::InputText("file", path_, sizeof path_);
         if (ImGui::Button("Open")) openFile(path_);
@@ -727,29 +787,51 @@ class Modeler {
             else
                 fresh();
         }
+        mustFit("New sphere");
         ImGui::TextWrapped("Open reads .vdb and .json, imports .obj/.ply/.stl; Save writes "
                            ".vdb, the stroke script for .json, a mesh for .obj/.ply/.stl.");
-        ImGui::InputFloat("voxel size", &voxelSizeInput_, 0.0f, 0.0f, "%.6f");
-        if (ImGui::Button("Resample (replay the history at this voxel size)")) {
-            const double h = voxelSizeInput_;
-            StrokeScript script = doc_->script();
-            const std::string dir = doc_->scriptDir();
-            doc_->endStroke();
-            if (!(h >= 1e-4 && h <= 0.5)) {
-                fail("the voxel size must lie between 0.0001 and 0.5");
-            } else {
-                const bool modified = doc_->modified();
-                startJob("resampling to voxel size " + formatNumber(h),
-                         [script, dir, h, modified](const Progress& p, Interrupter* stop) {
-                             auto d = std::make_unique<Document>(
-                                 Document::replayAt(script, dir, h, p, stop));
-                             if (modified) d->markModified();
-                             return d;
-                         });
+        // Detail: the history replayed at a finer or coarser voxel size, offered at the sizes
+        // artists pick from, each with what it would cost for this shape, or at any size.
+        ImGui::Separator();
+        char current[64];
+        std::snprintf(current, sizeof current, "%s (now)", detailName(info_.voxelSize).c_str());
+        if (ImGui::BeginCombo("detail", current)) {
+            for (const int n : kDetailLevels) {
+                const double h = 1.0 / n;
+                char item[96];
+                std::snprintf(item, sizeof item, "1/%d  (about %.0f MB)", n,
+                              std::ceil(memoryAtVoxelSize(h) / (1 << 20)));
+                const bool now = std::abs(h - info_.voxelSize) < 1e-9 * h;
+                if (ImGui::Selectable(item, now) && !now) {
+                    voxelSizeInput_ = float(h);
+                    resampleTo(h);
+                }
             }
+            ImGui::EndCombo();
         }
+        mustFit("detail");
+        ImGui::InputFloat("voxel size", &voxelSizeInput_, 0.0f, 0.0f, "%.6f");
+        mustFit("voxel size");
+        if (ImGui::Button("Resample at this voxel size")) resampleTo(voxelSizeInput_);
+        if (ImGui::IsItemHovered()) ImGui::SetTooltip("Replay the history at this voxel size");
+        mustFit("Resample at this voxel size");
         ImGui::EndDisabled();
         if (!status_.empty()) ImGui::TextWrapped("%s", status_.c_str());
+        // The engine's figures: for whoever wants them, out of an artist's way.
+        if (ImGui::CollapsingHeader("Statistics")) {
+            ImGui::Text("voxel size %.5g, active voxels %zu", info_.voxelSize, info_.activeVoxels);
+            ImGui::Text("triangles %zu, volume %.5f", info_.triangles, ctl_.volume());
+            ImGui::Text("frame %.1f ms, upload %.1f ms", frameMs_, uploadMs_);
+            const SegmentReport& last = finished_.report;
+            ImGui::Text("last segment: advect %.1f, renorm %.1f,", 1e3 * last.advectSeconds(),
+                        1e3 * last.stats.renormalizeSeconds);
+            ImGui::Text("  mesh %.1f ms", 1e3 * last.meshSeconds);
+            ImGui::Text("undo: %zu edits in %.1f of %.0f MB,", info_.undoCount,
+                        double(info_.undoBytes) / (1 << 20),
+                        double(doc_->undoBudget()) / (1 << 20));
+            ImGui::Text("  %zu more by replay", doc_->droppedCount());
+        }
+        ImGui::PopItemWidth();
         ImGui::End();
     }
 
@@ -869,8 +951,9 @@ class Modeler {
     double groundY_ = -1.0;
     struct Info {
         double voxelSize = 0;
-        std::size_t activeVoxels = 0, triangles = 0, undoCount = 0, undoBytes = 0;
+        std::size_t activeVoxels = 0, triangles = 0, undoCount = 0, undoBytes = 0, gridBytes = 0;
     } info_;
+    std::set<std::string> clipped_; // panel items cut off at the window's width
     std::string confirmText_;
     std::function<void()> confirmAction_;
     float voxelSizeInput_ = 1.0f / 64;

@@ -15,6 +15,18 @@ version=$(run --version)
 run --hide-ui --screenshot "$tmp/default.png" --replay-input "$tmp/none.json" --save "$tmp/default.vdb"
 "$py" "$here/check_image.py" centred "$tmp/default.png"
 
+# --- the panel at the default window size: every label fits its width, Add clay among the
+#     tools (the modeler reports any item cut off, src/app/modeler.cpp mustFit) -----------
+ASAN_OPTIONS=$app_asan "$app" --voxel-size 0.03125 --screenshot "$tmp/panel.png" \
+  --replay-input "$tmp/none.json" 2>"$tmp/panel.err"
+if grep -q "does not fit" "$tmp/panel.err"; then fail "$(cat "$tmp/panel.err")"; fi
+"$py" - "$tmp/panel.png" <<'PY'
+from PIL import Image
+im = Image.open(__import__("sys").argv[1])
+assert im.size == (1280, 800), im.size  # the default window
+PY
+echo "panel: every label fits at the default window size"
+
 # --- an idle window draws nothing: with no input and nothing running it waits for input
 #     (redrawing the same picture kept one and a half cores busy under Mesa) -------------
 ASAN_OPTIONS=$app_asan "$app" --size 640x480 --voxel-size 0.03125 --session-dir "$tmp/idle" \
