@@ -81,12 +81,16 @@ std::string findShaderDir(const std::string& argv0) {
     std::error_code ec;
     fs::path exe = fs::read_symlink("/proc/self/exe", ec);
     if (ec) exe = fs::absolute(argv0);
-    for (const fs::path& d : {exe.parent_path() / "shaders",
-                              exe.parent_path() / ".." / "share" / "sweepers" / "shaders",
-                              fs::path(SWEEPERS_SHADER_DIR)})
+    std::vector<fs::path> places{exe.parent_path() / "shaders",
+                                 exe.parent_path() / ".." / "share" / "sweepers" / "shaders"};
+    // The source tree only for the modeler in the tree it was built in: an installed one
+    // must find its installed shaders, not a checkout that may have changed since.
+    if (fs::equivalent(exe.parent_path(), fs::path(SWEEPERS_BUILD_DIR), ec))
+        places.emplace_back(SWEEPERS_SHADER_DIR);
+    for (const fs::path& d : places)
         if (fs::exists(d / "clay.vert")) return d.string();
-    throw std::runtime_error("cannot find the shaders (clay.vert) next to " + exe.string() +
-                             " or in " SWEEPERS_SHADER_DIR);
+    throw std::runtime_error("cannot find the shaders (clay.vert) in " + places[0].string() +
+                             " or " + places[1].string());
 }
 
 GlRenderer::GlRenderer(const std::string& shaderDir) {

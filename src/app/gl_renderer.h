@@ -53,8 +53,8 @@ class GlRenderer {
     std::size_t lastUploads_ = 0;
 };
 
-// Where the shaders are: next to the binary (shaders/ or ../share/sweepers/shaders), else
-// the source tree's shaders/.
+// Where the shaders are: next to the binary (shaders/ or ../share/sweepers/shaders, where
+// `cmake --install` puts them), else, for the modeler in its build tree, the source tree's.
 std::string findShaderDir(const std::string& argv0);
 
 } // namespace sweepers

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# What `cmake --install` and `cpack -G DEB` give a user: the programs, the shaders where the
+# installed modeler finds them, the examples and the guides, used from another directory;
+# and a Debian package holding them. Run under xvfb-run: install.sh BUILD_DIR
+set -euo pipefail
+build=$(cd "$1" && pwd)
+here=$(cd "$(dirname "$0")" && pwd)
+py=/usr/bin/python3
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail() { echo "FAIL: $*"; exit 1; }
+asan=${ASAN_OPTIONS:+$ASAN_OPTIONS:}detect_leaks=0 # Mesa's driver, as in tests/app/common.sh
+
+# --- install into a prefix of its own --------------------------------------------------
+prefix=$tmp/prefix
+cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" || fail "$(cat "$tmp/install.log")"
+for f in bin/sweepers bin/sweepers-cli share/sweepers/shaders/clay.vert \
+  share/sweepers/shaders/clay.frag share/sweepers/examples/drag.json \
+  share/sweepers/examples/tools/finger.vdb share/doc/sweepers/README.md \
+  share/doc/sweepers/cli.md share/doc/sweepers/stroke-scripts.md; do
+  [ -e "$prefix/$f" ] || fail "cmake --install put no $f"
+done
+echo "installed: programs, shaders, examples and guides under $prefix"
+
+# --- the installed programs, from another directory ------------------------------------
+mkdir "$tmp/work"
+cd "$tmp/work"
+examples=$prefix/share/sweepers/examples
+# finger.json sculpts with a tool of its own (tools/finger.vdb): the examples keep their files.
+ASAN_OPTIONS=$asan "$prefix/bin/sweepers-cli" apply "$examples/finger.json" -o finger.vdb \
+  --voxel-size 0.05 -q --json >finger.json || fail "the installed sweepers-cli failed"
+"$py" -c 'import json, sys; j = json.load(open(sys.argv[1])); assert j["topology"]["genus"] == 0, j' \
+  finger.json
+echo '{"events": []}' >none.json
+# The installed modeler must find its installed shaders: only a modeler in its build tree
+# reads the source tree's (src/app/gl_renderer.cpp).
+ASAN_OPTIONS=$asan "$prefix/bin/sweepers" --size 640x480 --voxel-size 0.03125 --hide-ui \
+  --screenshot shot.png --replay-input none.json 2>modeler.err || fail "$(cat modeler.err)"
+"$py" "$here/../app/check_image.py" centred shot.png
+mv "$prefix/share/sweepers/shaders" "$tmp/moved"
+if ASAN_OPTIONS=$asan "$prefix/bin/sweepers" --size 640x480 --hide-ui --screenshot none.png \
+  --replay-input none.json 2>moved.err; then
+  fail "the installed modeler ran without its installed shaders"
+fi
+grep -q "cannot find the shaders" moved.err || fail "without shaders: $(cat moved.err)"
+echo "installed modeler: clay on screen with its own shaders, one line without them"
+
+# --- the Debian package -----------------------------------------------------------------
+cpack -G DEB --config "$build/CPackConfig.cmake" -B "$tmp/pkg" >"$tmp/cpack.log" 2>&1 ||
+  fail "cpack: $(tail -5 "$tmp/cpack.log")"
+deb=$(ls "$tmp"/pkg/sweepers_*.deb)
+dpkg-deb -c "$deb" >"$tmp/contents"
+for f in ./usr/bin/sweepers ./usr/bin/sweepers-cli ./usr/share/sweepers/shaders/clay.vert \
+  ./usr/share/sweepers/examples/drag.json; do
+  grep -q " $f\$" "$tmp/contents" || fail "$(basename "$deb") holds no $f"
+done
+depends=$(dpkg-deb -f "$deb" Depends)
+# Every package it depends on is one Debian has (here, installed by the build's own needs).
+for p in $(echo "$depends" | tr ',' '\n' | sed 's/(.*//; s/|.*//' | tr -d ' '); do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" ||
+    fail "Depends names $p, which is not an installed Debian package"
+done
+echo "$depends" | grep -q libopenvdb || fail "Depends does not name OpenVDB's runtime: $depends"
+echo "$(basename "$deb"): both programs, the shaders and the examples; Depends: $depends"
+echo "install: all checks passed"
