@@ -1,13 +1,16 @@
 #include "io/stroke_script.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <initializer_list>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -25,6 +28,40 @@ using nlohmann::json;
 namespace {
 
 // Walks the JSON tree and knows where it is, so every complaint carries its location.
+// The fields each kind of object in a script may hold. Any other is refused: in a
+// hand-written script it is a typo. `duration` (on any stroke) and `time` (on a key) are
+// taken off their objects before the rest is read. docs/stroke-scripts.md names every one
+// (a test reads it against strokeScriptFields()).
+const std::pair<const char*, std::vector<const char*>> kScriptFields[] = {
+    {"script", {"sweepers", "grid", "start", "strokes"}},
+    {"grid", {"voxel_size", "half_width"}},
+    {"start", {"sphere", "vdb", "mesh", "grid"}},
+    {"sphere", {"center", "radius"}},
+    {"any stroke", {"duration"}},
+    {"sweep", {"type", "mirror", "tools"}},
+    {"tool", {"shape", "size", "falloff", "path"}},
+    {"keyed tool", {"shape", "size", "falloff"}},
+    {"placement", {"t", "r", "s"}},
+    {"keyed placement", {"time"}},
+    {"baked shape", {"vdb", "mesh", "grid", "voxel_size"}},
+    {"swirl", {"type", "at", "move", "radius", "ring", "swirls", "ball"}},
+    {"inflate", {"type", "at", "radius"}},
+    {"pinch or strangle", {"type", "at", "axis", "size", "falloff", "open"}},
+    {"keyframed", {"type", "tool", "keys"}},
+    {"slide", {"type", "mirror", "tools", "keys"}},
+    {"flow", {"type", "field", "from", "to", "segments"}},
+    {"rotation field", {"rotation"}},
+    {"rotation", {"center", "axis", "degrees_per_second", "radius", "falloff"}},
+    {"file field", {"vdb", "grid"}},
+    {"fluid", {"type", "radius", "path"}},
+};
+
+const std::vector<const char*>& fieldsOf(std::string_view object) {
+    for (const auto& [name, fields] : kScriptFields)
+        if (name == object) return fields;
+    throw std::logic_error("no field list for " + std::string(object));
+}
+
 class Reader {
   public:
     explicit Reader(const std::string& name, const std::string& baseDir = "")
@@ -39,9 +76,10 @@ class Reader {
         throw ScriptError(name_ + ": " + (where.empty() ? "/" : where) + ": " + why);
     }
 
-    void onlyKeys(const json& obj, const std::string& where,
-                  std::initializer_list<const char*> allowed) const {
+    // Refuses any field the kind of object (a name in kScriptFields) may not hold.
+    void onlyKeys(const json& obj, const std::string& where, std::string_view object) const {
         if (!obj.is_object()) fail(where, "expected an object");
+        const std::vector<const char*>& allowed = fieldsOf(object);
         for (auto it = obj.begin(); it != obj.end(); ++it) {
             bool known = false;
             for (const char* a : allowed)
@@ -93,7 +131,7 @@ class Reader {
 };
 
 Placement readPlacement(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"t", "r", "s"});
+    r.onlyKeys(v, at, "placement");
     Placement p;
     p.t = r.vec3(r.require(v, at, "t"), at + "/t");
     if (auto it = v.find("r"); it != v.end()) {
@@ -121,7 +159,7 @@ Placement readPlacement(const Reader& r, const json& v, const std::string& at) {
 
 // {"vdb": file, "grid": name} or {"mesh": file, "voxel_size": h}.
 BakedToolSource readBakedSource(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"vdb", "mesh", "grid", "voxel_size"});
+    r.onlyKeys(v, at, "baked shape");
     BakedToolSource b;
     const bool vdb = v.contains("vdb");
     if (vdb == v.contains("mesh")) r.fail(at, "expected exactly one of vdb, mesh");
@@ -166,9 +204,9 @@ void loadTool(const Reader& r, ToolSpec& t, const std::string& at) {
 ToolSpec readTool(const Reader& r, const json& v, const std::string& at,
                   const std::vector<Placement>* keyed = nullptr) {
     if (keyed)
-        r.onlyKeys(v, at, {"shape", "size", "falloff"});
+        r.onlyKeys(v, at, "keyed tool");
     else
-        r.onlyKeys(v, at, {"shape", "size", "falloff", "path"});
+        r.onlyKeys(v, at, "tool");
     ToolSpec t;
     const json& shapeValue = r.require(v, at, "shape");
     const std::string shape =
@@ -206,7 +244,7 @@ ToolSpec readTool(const Reader& r, const json& v, const std::string& at,
 }
 
 SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"type", "mirror", "tools"});
+    r.onlyKeys(v, at, "sweep");
     SweepStroke s;
     if (auto it = v.find("mirror"); it != v.end()) {
         const std::string m = r.string(*it, at + "/mirror");
@@ -268,7 +306,7 @@ Keyframes readKeys(const Reader& r, const json& v, const std::string& at, bool u
 }
 
 KeyframedStroke readKeyframed(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"type", "tool", "keys"});
+    r.onlyKeys(v, at, "keyframed");
     KeyframedStroke s;
     s.keys = readKeys(r, v, at, false);
     s.tool = readTool(r, r.require(v, at, "tool"), at + "/tool", &s.keys.placements);
@@ -287,7 +325,7 @@ KeyframedStroke readKeyframed(const Reader& r, const json& v, const std::string&
 }
 
 SlideStroke readSlide(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"type", "mirror", "tools", "keys"});
+    r.onlyKeys(v, at, "slide");
     SlideStroke s;
     json local = v;
     local.erase("keys");
@@ -297,7 +335,7 @@ SlideStroke readSlide(const Reader& r, const json& v, const std::string& at) {
 }
 
 FluidStroke readFluid(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"type", "radius", "path"});
+    r.onlyKeys(v, at, "fluid");
     FluidStroke s;
     s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
     const json& path = r.require(v, at, "path");
@@ -318,7 +356,7 @@ FluidStroke readFluid(const Reader& r, const json& v, const std::string& at) {
 }
 
 SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"type", "at", "move", "radius", "ring", "swirls", "ball"});
+    r.onlyKeys(v, at, "swirl");
     SwirlStroke s;
     s.at = r.vec3(r.require(v, at, "at"), at + "/at");
     s.move = r.vec3(r.require(v, at, "move"), at + "/move");
@@ -348,7 +386,7 @@ SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
 }
 
 InflateStroke readInflate(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"type", "at", "radius"});
+    r.onlyKeys(v, at, "inflate");
     InflateStroke s;
     s.at = r.vec3(r.require(v, at, "at"), at + "/at");
     s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
@@ -356,7 +394,7 @@ InflateStroke readInflate(const Reader& r, const json& v, const std::string& at)
 }
 
 FlowStroke readFlow(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"type", "field", "from", "to", "segments"});
+    r.onlyKeys(v, at, "flow");
     FlowStroke s;
     const json& f = r.require(v, at, "field");
     const std::string fat = at + "/field";
@@ -365,10 +403,10 @@ FlowStroke readFlow(const Reader& r, const json& v, const std::string& at) {
     } else if (f.is_string() && f.get<std::string>() == "vortex") {
         s.field.kind = FieldSpec::Kind::Vortex;
     } else if (f.is_object() && f.contains("rotation")) {
-        r.onlyKeys(f, fat, {"rotation"});
+        r.onlyKeys(f, fat, "rotation field");
         const json& rot = f["rotation"];
         const std::string rat = fat + "/rotation";
-        r.onlyKeys(rot, rat, {"center", "axis", "degrees_per_second", "radius", "falloff"});
+        r.onlyKeys(rot, rat, "rotation");
         s.field.kind = FieldSpec::Kind::Rotation;
         s.field.center = r.vec3(r.require(rot, rat, "center"), rat + "/center");
         s.field.axis = r.vec3(r.require(rot, rat, "axis"), rat + "/axis");
@@ -378,7 +416,7 @@ FlowStroke readFlow(const Reader& r, const json& v, const std::string& at) {
         s.field.radius = r.positive(r.require(rot, rat, "radius"), rat + "/radius");
         s.field.falloff = r.positive(r.require(rot, rat, "falloff"), rat + "/falloff");
     } else if (f.is_object() && f.contains("vdb")) {
-        r.onlyKeys(f, fat, {"vdb", "grid"});
+        r.onlyKeys(f, fat, "file field");
         s.field.kind = FieldSpec::Kind::Sampled;
         s.field.file = r.string(f["vdb"], fat + "/vdb");
         if (f.contains("grid")) s.field.gridName = r.string(f["grid"], fat + "/grid");
@@ -416,7 +454,7 @@ FlowStroke readFlow(const Reader& r, const json& v, const std::string& at) {
 // A pinch or a strangle: the same fields, checked by the tool's own rules.
 template <typename StrokeT, typename Check>
 StrokeT readTopologyTool(const Reader& r, const json& v, const std::string& at, Check check) {
-    r.onlyKeys(v, at, {"type", "at", "axis", "size", "falloff", "open"});
+    r.onlyKeys(v, at, "pinch or strangle");
     StrokeT s;
     s.at = r.vec3(r.require(v, at, "at"), at + "/at");
     s.axis = r.vec3(r.require(v, at, "axis"), at + "/axis");
@@ -437,13 +475,13 @@ StrokeT readTopologyTool(const Reader& r, const json& v, const std::string& at, 
 }
 
 StartShape readStart(const Reader& r, const json& v, const std::string& at) {
-    r.onlyKeys(v, at, {"sphere", "vdb", "mesh", "grid"});
+    r.onlyKeys(v, at, "start");
     if (v.size() - v.contains("grid") != 1) r.fail(at, "expected exactly one of sphere, vdb, mesh");
     if (v.contains("grid") && !v.contains("vdb"))
         r.fail(at + "/grid", "names a grid of a VDB start; this start is not a VDB file");
     StartShape s;
     if (auto it = v.find("sphere"); it != v.end()) {
-        r.onlyKeys(*it, at + "/sphere", {"center", "radius"});
+        r.onlyKeys(*it, at + "/sphere", "sphere");
         s.kind = StartShape::Kind::Sphere;
         s.center = r.vec3(r.require(*it, at + "/sphere", "center"), at + "/sphere/center");
         s.radius = r.positive(r.require(*it, at + "/sphere", "radius"), at + "/sphere/radius");
@@ -599,14 +637,14 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
     if (!duplicates.first.empty())
         throw ScriptError(name + ": " + duplicates.first +
                           " appears twice in the same object (which one is meant?)");
-    r.onlyKeys(root, "", {"sweepers", "grid", "start", "strokes"});
+    r.onlyKeys(root, "", "script");
     StrokeScript s;
     const json& version = r.require(root, "", "sweepers");
     if (!version.is_number_integer() || version.get<long long>() != 1)
         r.fail("/sweepers", "unsupported format version " + Reader::describe(version) +
                                 " (this build reads version 1)");
     if (auto it = root.find("grid"); it != root.end()) {
-        r.onlyKeys(*it, "/grid", {"voxel_size", "half_width"});
+        r.onlyKeys(*it, "/grid", "grid");
         s.grid.voxelSizeGiven = it->contains("voxel_size");
         s.grid.halfWidthGiven = it->contains("half_width");
         if (s.grid.voxelSizeGiven)
@@ -827,6 +865,14 @@ StrokeScript withAbsoluteFiles(StrokeScript s, const std::string& scriptDir) {
 
 void writeStrokeScript(const StrokeScript& script, const std::string& path) {
     writeTextAtomically(path, formatStrokeScript(script));
+}
+
+std::vector<std::string> strokeScriptFields() {
+    std::vector<std::string> out;
+    for (const auto& entry : kScriptFields)
+        for (const char* f : entry.second)
+            if (std::find(out.begin(), out.end(), f) == out.end()) out.emplace_back(f);
+    return out;
 }
 
 } // namespace sweepers

@@ -23,6 +23,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "sculpt/stroke.h"
 
@@ -42,6 +43,10 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
 // Read a file (its baked tools relative to it); a missing or unreadable file is a
 // ScriptError too. `text`, if given, receives the file's text as it was parsed.
 StrokeScript readStrokeScript(const std::string& path, std::string* text = nullptr);
+
+// Every field name a script may hold, in any object: the parser refuses all others, and the
+// reference, docs/stroke-scripts.md, must name each.
+std::vector<std::string> strokeScriptFields();
 // Serialize (numbers round-trip exactly): pretty-printed with `indent` spaces and a final
 // line break, or on one line without a line break when indent < 0.
 std::string formatStrokeScript(const StrokeScript& script, int indent = 2);

@@ -1,6 +1,8 @@
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -236,4 +238,28 @@ TEST(StrokeScript, ShippedScriptsAreValid) {
         EXPECT_NO_THROW(readStrokeScript(e.path().string())) << e.path();
     }
     EXPECT_GT(n, 0);
+}
+
+// The reference users write scripts from names every field the parser accepts, as `name`:
+// a field added to the parser and not to docs/stroke-scripts.md fails here.
+TEST(StrokeScript, TheReferenceNamesEveryFieldTheParserAccepts) {
+    std::ifstream in(std::string(SWEEPERS_DOCS_DIR) + "/stroke-scripts.md");
+    ASSERT_TRUE(in) << "docs/stroke-scripts.md is missing";
+    const std::string doc((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::vector<std::string> fields = strokeScriptFields();
+    EXPECT_GE(fields.size(), 30u); // every object's fields, not an empty list
+    for (const std::string& f : fields)
+        EXPECT_NE(doc.find("`" + f + "`"), std::string::npos)
+            << "docs/stroke-scripts.md does not name the field `" << f << "`";
+}
+
+// The list is the parser's own: a field it names is accepted where the list puts it, and a
+// name outside it is refused.
+TEST(StrokeScript, TheFieldListIsWhatTheParserAccepts) {
+    const std::vector<std::string> fields = strokeScriptFields();
+    for (const char* f : {"sweepers", "half_width", "degrees_per_second", "swirls", "open",
+                          "duration", "time", "voxel_size"})
+        EXPECT_NE(std::find(fields.begin(), fields.end(), f), fields.end()) << f;
+    EXPECT_THROW(parseStrokeScript(R"({"sweepers": 1, "strokes": [], "colour": 1})", "s.json"),
+                 ScriptError);
 }
