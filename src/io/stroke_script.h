@@ -1,5 +1,5 @@
-// Stroke scripts: the JSON file format of the stroke model (sculpt/stroke.h); the README
-// documents every field.
+// Stroke scripts: the JSON file format of the stroke model (sculpt/stroke.h);
+// docs/stroke-scripts.md documents every field.
 //
 //   { "sweepers": 1,
 //     "grid":  { "voxel_size": 0.02, "half_width": 3 },
@@ -12,7 +12,7 @@
 //                  { "type": "flow", "field": "enright" | {"vdb": F, "grid": N} | ...,
 //                    "from": t0, "to": t1, "segments": n },
 //                  { "type": "fluid", "radius": r, "path": [[..], [..]] } ] }
-//     (and pinch, strangle, keyframed, slide: the README documents every field)
+//     (and pinch, strangle, keyframed, slide: docs/stroke-scripts.md documents every field)
 //     (any stroke may add "duration": seconds, for films: sculpt/film.h)
 //
 // Reading validates everything, including that every segment's motion has a logarithm,

@@ -1,4 +1,4 @@
-// VDB files (the README's "Files" section): one FloatGrid named "surface", class level
+// VDB files (docs/files.md): one FloatGrid named "surface", class level
 // set, linear transform with the voxel size, background = half-width x voxel size,
 // negative inside, metadata creator / voxel_size / half_width. Reading accepts any float
 // level set of any name: the one named, or else the first usable one in the file (a level
