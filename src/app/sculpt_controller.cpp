@@ -394,10 +394,10 @@ std::vector<Placement> SculptController::placementsTo(const Placement& target) c
 void SculptController::launch(std::function<SegmentReport()> task) {
     workSince_ = pendingSince_;
     // A replay waits for each piece, so the window's thread runs it itself. On a worker
-    // thread, the worker and TBB's thread it wakes often queued on one of the two vCPUs of
-    // a virtual machine whose kernel sees no shared cache (so a wakeup looks for no idle
-    // core) while the other stayed idle for up to 12 ms: in `--latency-report` of
-    // tests/app/long_drag.json at 1/128, a third of the segments took 3.5 ms longer.
+    // thread, the worker and TBB's thread it wakes can queue on one of the two vCPUs of a
+    // virtual machine whose kernel sees no shared cache (so a wakeup looks for no idle
+    // core) while the other stays idle: a replay, which measures latency, would measure
+    // the scheduler instead of the engine.
     work_ = std::async(waitEach_ ? std::launch::deferred : std::launch::async, std::move(task));
     if (waitEach_) work_.wait();
 }

@@ -137,9 +137,8 @@ std::vector<std::unique_ptr<StepDeformation>> planStrangle(const StrangleSpec& s
     // than its ratio q (the field's angular slope adds about 7 ln q times r / d at distance
     // d from the circle), and the advection widens the source band only up to a stretch of
     // 32: past it the sampled values are clamped and the face comes out terraced to the
-    // grid. One last segment from a tenth of the size down to a quarter voxel went past it
-    // (at 1/128, 91% of the interface had a unit gradient); with halvings the largest
-    // stretch on the same strangle was about 27 (the band widened to 42 voxels).
+    // grid. One last segment from a tenth of the size down to a quarter voxel goes past it;
+    // halvings keep every segment's stretch below it.
     std::vector<std::unique_ptr<StepDeformation>> parts;
     std::size_t first = 0;
     for (std::size_t k = 1; k < radii.size(); ++k) {

@@ -6,8 +6,8 @@
 // the method of characteristics with the monotone interpolant of appendix C.1, implicit
 // diffusion (4.23) and the pressure projection (4.24, 4.25). The thesis solves the last two by
 // conjugate gradients; in the closed cube both have constant coefficients, and box_solve.h
-// solves them exactly (at 72^3 cells 0.4 s, where conjugate gradients took 4.5 s and 664
-// iterations for the pressure alone to reach a billionth).
+// solves them exactly by changing bases, in a fixed number of fast transforms, where
+// conjugate gradients need hundreds of iterations for the pressure alone.
 // Unlike the thesis's collocated grid (C.1-C.3), velocities live on the faces of the cells (a
 // MAC grid): there the discrete Laplacian is exactly the divergence of the gradient, so the
 // projected field is divergence-free to rounding, where the collocated one keeps a

@@ -1,5 +1,5 @@
 // The swept-fluid solution (deform/swept_fluid.h) is solved once per machine: the first run
-// that needs it solves it (about 5 s at 72^3 cells) and keeps it as a VDB file in the cache
+// that needs it solves it (a noticeable wait at 72^3 cells) and keeps it as a VDB file in the cache
 // directory, $SWEEPERS_CACHE, else $XDG_CACHE_HOME/sweepers, else ~/.cache/sweepers; later
 // runs read it (in a child process, as any file we did not just write). A cache file that is
 // damaged or was solved with other parameters is solved again and replaced; a cache that

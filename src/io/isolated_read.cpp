@@ -60,7 +60,7 @@ bool serveReadIfAsked() {
         args.push_back(arg);
     if (args.size() != 5 || args[1] != kMarker) return false;
     // One thread: its memory limit holds the reader's work, not a stack and a malloc arena
-    // for each of the machine's cores (64 MB of address space each).
+    // (tens of megabytes of address space each) for each of the machine's cores.
     const tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
     try {
         openvdb::GridBase::ConstPtr grid;
@@ -78,10 +78,9 @@ bool serveReadIfAsked() {
             about = file.name + '\0' + std::to_string(file.levelSets) + '\0';
             grids = file.grids;
         }
-        // Straight into the pipe, and not compressed: the parent reads it at once, and
-        // compressing it here to decompress it there cost about a seventh of opening a
-        // level set (`sweepers-cli info` of a sphere at 1/256: 2.60 s, 2.22 s without,
-        // medians of seven runs). Nor is it held here in a string first.
+        // Straight into the pipe, and not compressed: the parent reads it at once, so
+        // compressing it here only to decompress it there would be pure cost. Nor is it held
+        // here in a string first.
         namespace bio = boost::iostreams;
         bio::stream<bio::file_descriptor_sink> out(kGridFd, bio::never_close_handle);
         openvdb::io::Stream stream(out);
@@ -106,9 +105,9 @@ const bool gServed = serveReadIfAsked();
 // What the reader may use: a file expands when it is decompressed, but not without bound;
 // a damaged size field can ask for gigabytes. Generous for real files (64 times the file,
 // 512 MB at least, counting the process's own mappings), never more than is available.
-// The floor is what a damaged small file can make the reader fill before it is stopped:
-// with 2 GB that took 3.5 s (9 s under AddressSanitizer), with 512 MB 0.1 s; a child
-// reading a 14 MB level set needs 192 MB.
+// The floor is what a damaged small file can make the reader fill before it is stopped: a
+// floor of gigabytes would let each damaged file cost seconds of filling memory, while a
+// real level set needs far less than 64 times its size.
 double readerMemory(const std::string& path) {
     struct stat st {};
     const double file = ::stat(path.c_str(), &st) == 0 ? double(st.st_size) : 0.0;
@@ -154,8 +153,8 @@ ChildRead readInChild(const char* kind, const std::string& path, const std::stri
     std::vector<const char*> argv{self.c_str(), kMarker,          kind,
                                   path.c_str(), gridName.c_str(), nullptr};
     // The child's environment: the parent's, and under AddressSanitizer a resident-memory
-    // limit in its options (without one, a damaged file that makes the reader allocate
-    // gigabytes took 30 s there, where the address-space limit stops it in 3).
+    // limit in its options (AddressSanitizer cannot run under an address-space limit, and
+    // without a limit a damaged file could make the reader allocate gigabytes).
     // Threads the libraries start themselves still get an arena each unless glibc is told.
     std::vector<std::string> env{"MALLOC_ARENA_MAX=1"};
     for (char** e = environ; *e; ++e)

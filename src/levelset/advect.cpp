@@ -43,8 +43,8 @@ float trilinearIn(const float (&c)[2][2][2], const openvdb::Vec3d& uvw) {
 }
 
 // The cell (its lowest corner) holding index-space point p: the floor on each axis, as a
-// truncation and a compare. std::floor is a call into libm in the baseline x86-64 build (23
-// instructions more a sampled voxel of the drag); the integers are the same for any point
+// truncation and a compare. std::floor is a call into libm in the baseline x86-64 build, on
+// every sampled voxel; the integers are the same for any point
 // within a grid's coordinates.
 openvdb::Coord cellOf(const openvdb::Vec3d& p) {
     const auto down = [](double x) {
@@ -299,8 +299,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
             if (only && !wanted) continue;
             // The leaf's pre-images first, all of them, then its samples: each loop's steps
             // are independent from one voxel to the next, so the processor overlaps them,
-            // where a sample waited on its map's call and the next map on the sample (the
-            // drag at 1/128 and 1/256 took 4% less time as a whole).
+            // where a sample waited on its map's call and the next map on the sample.
             const leafwords::Words inBox = leafwords::inBox(box, leaf.origin());
             int listed = 0;
             for (int wx = 0; wx < 8; ++wx) {
@@ -477,8 +476,7 @@ void makeLeavesWithin(Grid& grid, const VoxelList& mask, int beyond,
                         across[dy + 1][dz + 1] |= std::uint64_t(1) << (8 * y + z);
     // The leaves missing are found in parallel, reading the tree, and made after, on this
     // thread (the tree changes): most of the up to 27 places a mask leaf reaches hold a leaf
-    // already, and looking them all up on one thread took 0.66 to 0.85 ms of a drag segment
-    // at 1/256.
+    // already, and looking them all up on one thread was a serial part of every segment.
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> missing;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mask.size()), [&](const auto& r) {
         const auto acc = grid.getConstAccessor();
@@ -590,8 +588,8 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     {
         // Found leaf by leaf in parallel, then listed in leaf order (the stretch samples
         // every fourth one of that list): each leaf's voxels counted first, then written
-        // where the counts before it put them (a list per leaf, joined on one thread, took
-        // 0.12-0.17 ms of the 1.9 ms band growth of a drag segment at 1/128).
+        // where the counts before it put them (a list per leaf, joined on one thread, was a
+        // serial part of band growth).
         const auto leaves = leavesIn(std::as_const(grid.tree()), region);
         std::vector<LeafNode::NodeMaskType> crossing(leaves.size());
         std::vector<std::size_t> first(leaves.size() + 1, 0);
@@ -631,8 +629,8 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
     stats.interfaceVoxels = interface.size();
     // Each thread lists the images leaf by leaf, a list of its own, a run of interface voxels
     // at a time; a leaf the runs share is listed by each (dilatedByCube joins the entries).
-    // Marked in a tree per thread, they cost a tree's look-up per image and, at 1/256, some
-    // 1 ms a drag segment to mark, list and free.
+    // Marked in a tree per thread, they cost a tree's look-up per image, and the trees had
+    // to be listed and freed after.
     tbb::enumerable_thread_specific<VoxelList> marks;
     const VoxelPlacement place(grid.transform());
     // The voxels the renormalization seeds from lie within 1.5 voxels of the new surface

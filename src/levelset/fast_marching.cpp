@@ -148,10 +148,10 @@ class Domain {
 
   private:
     // Finds the leaves (at positions `at`, in leaves) by position: in a table over their box
-    // where a band fills enough of it (a drag segment's 4,000 leaves at 1/256 lie in a box of
-    // 22,000), else (shapes far apart) in the leaves sorted by position: there a binary
-    // search for each neighbour took 0.8 ms and the sort 0.2 ms more; the positions, the
-    // table and the look-ups take 0.3 ms.
+    // where a band fills enough of it (a drag's band fills about a fifth of its box of
+    // leaves), since a table look-up is one load where a binary search is a dozen dependent
+    // ones; else (shapes far apart, where a table over their box would be mostly empty) in
+    // the leaves sorted by position.
     void index(const std::vector<openvdb::Coord>& at) {
         table_.reset();
         sorted_.clear();
@@ -622,8 +622,8 @@ class Renormalizer {
     // Which of two classes leaf l belongs to, by the parity of the sum of its position (a
     // checkerboard): leaves of one class never share a face, and a block reads only its leaf
     // and the faces of its neighbours, so the leaves of a class are solved in parallel. (The
-    // eight classes of the parities along each axis waited at eight barriers a round where
-    // two do; the renormalization of a drag segment took 7% longer.)
+    // eight classes of the parities along each axis would wait at eight barriers a round
+    // where two do.)
     int classOf(std::size_t l) const {
         const openvdb::Coord o = b_.leaf(l).origin() >> Leaf::LOG2DIM;
         return (o.x() + o.y() + o.z()) & 1;
@@ -643,8 +643,8 @@ class Renormalizer {
 
     // load() for a block whose rows run along leaf axis RowAxis: the block is written four
     // values at a time, read by fixed strides, each voxel's side taken from the sign of its
-    // value. (With a bit test and two selects a voxel, filling blocks took 207M of the 1141M
-    // instructions renormalizing the drag's first ten segments at 1/128; now 123M.)
+    // value, so that filling a block costs a few instructions per four voxels rather than a
+    // bit test and two selects per voxel.
     template <int RowAxis> void loadAs(std::size_t l, int rim, Block& block) const {
         using Index = std::ptrdiff_t; // offsets into the block and the leaves
         constexpr Index R = Block::kRim;
@@ -726,11 +726,11 @@ class Renormalizer {
     //    the voxels next to it to its neighbours, which are solved again, until nothing
     //    changes. Within a leaf, sweeps over its rows solve eight voxels at once until no
     //    value moves (settle); a voxel solved in the order of the values, as fast marching
-    //    does, waited on the one before it: each update is a chain of a square root and a
-    //    division, about 140 cycles, where a row of eight takes about 100. Both sides are
-    //    solved at once (an update reads only its own side). Everything a leaf reads is in a
-    //    block of 14 KB, where fast marching's single front swept the whole region and missed
-    //    the cache at nearly every voxel.
+    //    does, waits on the one before it, each update a long chain of a square root and a
+    //    division, where the eight lanes of a row proceed together. Both sides are solved at
+    //    once (an update reads only its own side). Everything a leaf reads is in a block
+    //    small enough for the first-level cache, where fast marching's single front sweeps
+    //    the whole region and misses the cache at nearly every voxel.
     void solve() {
         const std::size_t leaves = b_.leafCount();
         const int reach = order_ == FmmOrder::Second ? 2 : 1; // how far a stencil reads
@@ -814,8 +814,9 @@ class Renormalizer {
                           reach};
         Bits todo = first ? solvable : inBlockOrder(handed, axis) & solvable, changed{};
         left = Bits{};
-        // Each side in the direction its distances grow, every sweep (turning the directions
-        // in turn, as fast sweeping does, took 14% more rows on the drag).
+        // Each side in the direction its distances grow, every sweep: the values travel the
+        // way the distances do, so turning the directions in turn, as fast sweeping does,
+        // spends sweeps going against them.
         const unsigned outward = unsigned(layout_[l]) >> 2;
         for (int sweep = 0; sweep < kMostSweeps; ++sweep) {
             Bits moved{};
@@ -876,11 +877,10 @@ class Renormalizer {
     // hold. Called before the changed values are written back (dist_ holds the old ones);
     // the neighbours are of another class, so nothing writes them meanwhile. The layers on
     // either side of a face are compared as planes of 64 bits, and only the voxels this
-    // leaves have their values compared (walking each changed voxel's steps, a bit test at
-    // a time, took 154M of the 1141M instructions renormalizing the drag's first ten
-    // segments at 1/128), without a branch on each comparison. A neighbour not solved yet
-    // (`seen`) gets nothing: its first solve takes all its free voxels anyway (in the first
-    // round: 38% of the comparisons of a drag segment at 1/256 were for such neighbours).
+    // leaves have their values compared (rather than walking each changed voxel's steps a
+    // bit test at a time), without a branch on each comparison. A neighbour not solved yet
+    // (`seen`) gets nothing: its first solve takes all its free voxels anyway, and in the
+    // first round most neighbours are such.
     void handOn(std::size_t l, const Bits& changed, const Block& block, int reach,
                 const std::vector<std::uint8_t>& seen, std::atomic<std::uint64_t>* inbox,
                 std::atomic<bool>* pending) const {
@@ -1009,7 +1009,7 @@ class Renormalizer {
     // Per leaf: its values (the grid's, as they were sampled).
     std::vector<const float*> phi_;
     // Every entry is written by the constructor's parallel loop over the leaves, so this is
-    // allocated without the serial zeroing of a std::vector (4 MB for a drag segment).
+    // allocated without the serial zeroing of a std::vector, which would run on one thread.
     // The distance found so far (kInf: none yet), with its voxel's sign (signedAs).
     std::unique_ptr<float[]> dist_;
     // Per leaf: the voxels on or next to a feature one voxel thin (flagThin).

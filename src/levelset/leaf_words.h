@@ -22,7 +22,7 @@ constexpr Word kY0 = 0xffull, kY7 = kY0 << 56;              // the voxels at y =
 
 // Bit k: whether v[k] < 0, for k < n (n <= 64): the signs of a row or a word of a leaf's
 // values, four compares at once where the CPU has SSE (a compare, a shift and an or per
-// value made the scans for the surface 5% of a drag segment at 1/256). The same answer as
+// value made these scans, which every segment runs, a visible share of it). The same answer as
 // `v[k] < 0.0f` for every value, -0 and NaN included.
 inline Word negatives(const float* v, int n) {
     Word w = 0;

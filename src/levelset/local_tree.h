@@ -49,9 +49,9 @@ template <typename TreeT> auto leavesIn(TreeT& tree, const openvdb::CoordBBox& b
 
 // Frees the nodes of `tree` on the calling thread, leaving it empty. OpenVDB's Tree::clear,
 // which a tree's destructor calls, frees the leaves in a parallel loop, and threads freeing
-// small blocks of one heap at once contend for it: mask trees of 2,000-3,400 leaves, as a
-// drag segment at 1/256 made, took 0.4-0.7 ms each to free that way. A segment frees its
-// copies and its threads' marks so.
+// small blocks of one heap at once contend for it, so that freeing a few thousand leaves in
+// parallel is slower than freeing them on one thread. A segment frees its copies and its
+// threads' marks so.
 template <typename TreeT> void freeOnThisThread(TreeT& tree) {
     std::vector<typename TreeT::LeafNodeType*> leaves;
     tree.stealNodes(leaves);
@@ -180,9 +180,8 @@ inline std::size_t floodSignsIn(Grid::TreeType& tree, const std::vector<LeafNode
             floodLeafSigns(*leaves[l], inside, outside);
     });
     // Each node reads only its own children, so the nodes of a level are filled in parallel
-    // too: one after the other they took 0.57-0.63 ms of a drag segment at 1/128 (the four
-    // upper nodes of 32768 tiles a stroke near the origin crosses 0.24-0.27 of it), in
-    // parallel 0.21-0.34.
+    // too: an upper node holds 32768 tiles, and a stroke near the origin crosses four of
+    // them, too much work to leave to one thread.
     using Upper = Grid::TreeType::RootNodeType::ChildNodeType;
     using Lower = Upper::ChildNodeType;
     std::vector<Upper*> uppers;

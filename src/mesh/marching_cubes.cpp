@@ -231,8 +231,8 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
     if (madeFrom == into.madeFrom) return false; // the same triangles again
     // Made in storage of the thread's, then copied into the chunk at its size: grown a
     // vertex at a time, a new chunk's vectors were allocated again at every doubling (some
-    // seven times each for a leaf's sixty or so vertices), and in a profile of whole-grid
-    // meshing, allocating and freeing took about a fifth of its samples.
+    // seven times each for a leaf's sixty or so vertices), and allocating and freeing
+    // became a large part of whole-grid meshing.
     thread_local MeshChunk chunk;
     chunk.positions.clear();
     chunk.normals.clear();
@@ -341,8 +341,8 @@ std::size_t SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvd
     // Each leaf into the chunk it has (its storage reused) or into a new one, which joins
     // the map only when it holds a triangle (a map's elements stay where they are, so the
     // chunks are written in parallel); chunks left without a triangle go. The chunks are
-    // looked up in the parallel loop too (nothing changes the map meanwhile): on one thread
-    // the look-ups took some 0.6 ms of a drag segment's meshing at 1/256.
+    // looked up in the parallel loop too (nothing changes the map meanwhile): done on one
+    // thread before the loop, they were a serial part of every segment's meshing.
     std::vector<MeshChunk*> into(origins.size());
     std::vector<MeshChunk> fresh(origins.size());
     std::atomic<std::size_t> meshed{0};

@@ -172,13 +172,13 @@ done
 # --- a fixed corpus of damaged files ---------------------------------------------------------
 "$cli" new -o small.vdb --voxel-size 0.1 --radius 0.5
 for ext in ply obj stl; do "$cli" mesh small.vdb -o "small.$ext" 2>/dev/null; done
-# 225 cases (a mesh case, whose script imports it, costs the most: 0.6 s under the
-# sanitizers, a VDB 0.46 s, a script 0.21 s); 141 s under the sanitizers beside another
-# test when they were 300.
+# 225 cases: a mesh case, whose script imports it, costs the most under the sanitizers, so
+# meshes get the fewest.
 for ext in ply obj stl; do "$py" "$here/mutate.py" "small.$ext" corpus 25 7; done
 "$py" "$here/mutate.py" "$data/horn.json" corpus 60 7
 "$py" "$here/mutate.py" small.vdb corpus 90 7
-# Builtins only around each run (300 runs: other processes per case cost 20 s). A refusal
+# Builtins only around each run (a few more processes per case, times hundreds of cases,
+# would add up). A refusal
 # is one line that says something in words, never just an exception's name (bytes, not
 # characters: a message may quote the damaged file).
 LC_ALL=C
