@@ -62,7 +62,13 @@ static int run(int argc, char** argv) {
         ->check(CLI::Range(0.0, 1e7));
     app.add_option("--threads", threads, "worker threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
-    CLI11_PARSE(app, argc, argv);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        // As sweepers-cli: --help and --version are not errors, anything else is a usage
+        // error (exit 2).
+        return app.exit(e) == 0 ? 0 : 2;
+    }
     o.undoBudgetBytes = std::size_t(undoMb * 1024 * 1024);
     try {
         if (!script.empty()) {

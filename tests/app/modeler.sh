@@ -10,6 +10,9 @@ run() { ASAN_OPTIONS=$app_asan "$app" --size 640x480 --voxel-size 0.03125 "$@"; 
 echo '{"events": []}' >"$tmp/none.json"
 version=$(run --version)
 [ "$version" = "sweepers $("$cli" --version | cut -d' ' -f2)" ] || fail "sweepers --version: '$version'"
+rc=0
+run --no-such-option 2>/dev/null || rc=$?
+[ "$rc" = 2 ] || fail "a usage error exited $rc, not 2 (docs/cli.md's codes hold for the modeler too)"
 
 # --- the default scene: a sphere in the middle -----------------------------------------
 run --hide-ui --screenshot "$tmp/default.png" --replay-input "$tmp/none.json" --save "$tmp/default.vdb"
