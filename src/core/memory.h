@@ -33,8 +33,8 @@ bool restartPeakResident();
 
 // Keeps the memory the process frees for its next allocations instead of handing it back
 // to the kernel at once: a stroke segment allocates and frees the same few megabytes every
-// time, and every page handed back and asked for again costs a fault of several
-// microseconds on a virtual machine (a sixth of a drag segment at 1/128 on one). Called
+// time, and every page handed back and asked for again costs a page fault, which on a
+// virtual machine is slow enough to be a large part of a segment. Called
 // first thing by the executables; does nothing where the C library is not glibc.
 void keepFreedMemory();
 

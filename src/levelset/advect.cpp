@@ -34,7 +34,7 @@ constexpr int kSeedReach = 2;
 
 // Trilinear interpolation of a cell's corner values at offset uvw inside it, in single
 // precision (the values are floats; OpenVDB's BoxSampler turns every product into a double
-// and back, which made this a twelfth of a drag segment).
+// and back, in the innermost loop of sampling).
 float trilinearIn(const float (&c)[2][2][2], const openvdb::Vec3d& uvw) {
     const float u = float(uvw[0]), v = float(uvw[1]), w = float(uvw[2]);
     const auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
@@ -57,8 +57,8 @@ openvdb::Coord cellOf(const openvdb::Vec3d& p) {
 // New values of the leaves a sampling pass resamples, kept beside the grid until every sample
 // is taken (samples read the grid as it was), then swapped in: 512 values a leaf, and per
 // leaf the voxels whose values changed (only those are written). Writing into the leaves
-// instead needed a copy of each one first (copy on write): some 2,000 leaves a drag segment
-// at 1/256, allocated, put in a tree on one thread and freed one at a time.
+// instead needed a copy of each one first (copy on write): thousands of leaves a segment,
+// allocated, put in a tree on one thread and freed one at a time.
 struct Staged {
     std::unique_ptr<float[]> values;
     std::vector<leafwords::Words> changed;

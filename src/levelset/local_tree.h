@@ -26,8 +26,7 @@ namespace sweepers {
 
 // The leaves of `tree` (a Grid::TreeType, const or not) overlapping `box`. A leaf's place is
 // read from its parent (the iterator's coordinate), so the leaves left out are not touched:
-// reading each one's origin cost a cache miss a leaf, a fifth of a millisecond for the 4,000
-// leaves of a drag segment at 1/256.
+// reading each one's origin would cost a cache miss a leaf.
 template <typename TreeT> auto leavesIn(TreeT& tree, const openvdb::CoordBBox& box) {
     using Leaf = std::conditional_t<std::is_const_v<TreeT>, const LeafNode, LeafNode>;
     std::vector<Leaf*> out;

@@ -20,8 +20,8 @@ struct LevelSetMeasures {
 LevelSetMeasures measureLevelSet(const Grid& grid);
 
 // The enclosed volume alone (world units), as measureLevelSet finds it: without the
-// curvature integral, the Euler count and the components, which cost the rest of a full
-// measure (on a drag at voxel size 1/128, twice what ten stroke segments cost).
+// curvature integral, the Euler count and the components, which walk the whole band and
+// cost more than many stroke segments.
 double levelSetVolume(const Grid& grid);
 
 // Euler characteristic of the surface, counted exactly on the grid: twice that of the

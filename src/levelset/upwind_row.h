@@ -18,8 +18,8 @@ struct RowBlock {
 // and writes the values that moved by more than the tolerance. Returns those lanes.
 unsigned relaxRow(const RowBlock& block, int b, unsigned lanes);
 
-// relaxRow's way for this CPU, to call directly: a solve relaxes some 600,000 rows a drag
-// segment at 1/256, and choosing the way at each of them cost two calls instead of one.
+// relaxRow's way for this CPU, to call directly: a solve relaxes hundreds of thousands of
+// rows, and choosing the way at each of them would cost two calls instead of one.
 using RowRelaxer = unsigned (*)(const RowBlock& block, int b, unsigned lanes);
 RowRelaxer rowRelaxer();
 

@@ -171,7 +171,8 @@ constexpr std::array<int, 8> kBlockOffset = cornerOffsets(LeafBlock::index);
 // The vertices a leaf's cubes have made so far, by where they lie: a crossing on the edge
 // from a cube corner along an axis, or the centre of one of a cube's cycles (a cube has at
 // most four: that many corners of a cube can be pairwise non-adjacent). Array lookups
-// instead of a hash map (meshing is a sixth of a stroke segment).
+// instead of a hash map: meshing runs on every stroke segment, and a hash per corner would
+// cost more than the cubes.
 class LeafVertices {
   public:
     static constexpr int kMaxCycles = 4;
@@ -444,9 +445,9 @@ std::size_t SurfaceMesher::update(const Grid& grid,
         marks += read.back().volume();
     }
     // The origins, each once: marked in a dense array over the extent of the boxes, unless the
-    // boxes lie so far apart that the array would hold many more entries than marks. (With
-    // some 6,000 boxes a drag segment at 1/256, each read by up to 27 leaves, sorting their
-    // origins made its meshing 1.6 to 1.8 times as long.)
+    // boxes lie so far apart that the array would hold many more entries than marks. (A
+    // segment reports thousands of boxes, each read by up to 27 leaves: sorting that many
+    // origins would cost more than meshing them.)
     std::vector<openvdb::Coord> origins;
     const std::size_t cells = extent.empty() ? 0 : extent.volume();
     if (cells <= 2 * marks + 4096) {
