@@ -345,16 +345,17 @@ int runApply(const ApplyArgs& a) {
         std::fprintf(stderr, "mesh volume before: %.7f\n", meshBefore);
         std::fprintf(stderr,
                      "stroke segment steps interface widened reach  grow_ms sample_ms renorm_ms "
-                     "mesh_ms leaves mesh_volume  visited copied flooded\n");
+                     "mesh_ms serial_ms leaves mesh_volume  visited copied flooded\n");
         for (const auto& r : reports)
             std::fprintf(
                 stderr,
-                "%6zu %7zu %5d %9zu %7.1f %5d %8.1f %9.1f %9.1f %7.1f %6zu %11.7f %9zu %6zu "
-                "%7zu\n",
+                "%6zu %7zu %5d %9zu %7.1f %5d %8.1f %9.1f %9.1f %7.1f %9.2f %6zu %11.7f %9zu "
+                "%6zu %7zu\n",
                 r.stroke, r.segment, r.stats.subSteps, r.stats.interfaceVoxels, r.stats.widenedTo,
                 r.stats.sampledReach, 1e3 * r.stats.growSeconds, 1e3 * r.stats.sampleSeconds,
-                1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds, r.remeshedLeaves,
-                r.meshVolume, r.stats.voxelsVisited, r.stats.leavesCopied, r.stats.leavesFlooded);
+                1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds, 1e3 * r.serialSeconds(),
+                r.remeshedLeaves, r.meshVolume, r.stats.voxelsVisited, r.stats.leavesCopied,
+                r.stats.leavesFlooded);
     }
     double adv = 0, ren = 0, grow = 0;
     for (const auto& r : reports) {

@@ -5,9 +5,11 @@
 #include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
 #include "levelset/monotone_cubic.h"
+#include "levelset/parallel.h"
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -31,6 +33,10 @@ constexpr std::size_t kStretchSampling = 4;
 // How far around the images of the surface sampling reaches: a seed of renormalization lies
 // within a voxel of the new surface along an axis, and its central differences read one more.
 constexpr int kSeedReach = 2;
+
+// How many interface voxels a thread maps through the sub-steps at once: enough for the
+// batched maps to pay, few enough for the points to stay in cache.
+constexpr std::size_t kMapBatch = 256;
 
 // Trilinear interpolation of a cell's corner values at offset uvw inside it, in single
 // precision (the values are floats; OpenVDB's BoxSampler turns every product into a double
@@ -61,7 +67,17 @@ openvdb::Coord cellOf(const openvdb::Vec3d& p) {
 // allocated, put in a tree on one thread and freed one at a time.
 struct Staged {
     std::unique_ptr<float[]> values;
+    std::size_t capacity = 0; // values it holds room for
     std::vector<leafwords::Words> changed;
+
+    // Room for n leaves' values, kept from pass to pass; counts in `growths` when it grows.
+    void reserve(std::size_t leaves, std::atomic<std::size_t>& growths) {
+        const std::size_t n = leaves * LeafNode::SIZE;
+        if (n <= capacity) return;
+        capacity = std::max(2 * n, 2 * capacity);
+        values.reset(new float[capacity]);
+        ++growths;
+    }
 
     // Calls body(to, from, pos) for each changed voxel of the l-th leaf: its place in `to`
     // (the leaf's 512 values) and in the staged values.
@@ -75,7 +91,7 @@ struct Staged {
     // Swaps the staged values of the changed voxels with the leaves' (the staged values are
     // then the old ones).
     void swapInto(const std::vector<LeafNode*>& leaves) {
-        tbb::parallel_for(std::size_t(0), leaves.size(), [&](std::size_t l) {
+        parallelFor(std::size_t(0), leaves.size(), [&](std::size_t l) {
             forEachChanged(
                 l, leaves[l]->buffer().data(),
                 [](float* to, float* from, std::size_t pos) { std::swap(to[pos], from[pos]); });
@@ -114,8 +130,8 @@ class SampleSource {
     template <typename Leaves> static void addCopies(Grid& copies, const Leaves& leaves) {
         // Copied in parallel, then put in the tree (which is not safe to grow in parallel).
         std::vector<LeafNode*> made(leaves.size());
-        tbb::parallel_for(std::size_t(0), leaves.size(),
-                          [&](std::size_t i) { made[i] = new LeafNode(*leaves[i]); });
+        parallelFor(std::size_t(0), leaves.size(),
+                    [&](std::size_t i) { made[i] = new LeafNode(*leaves[i]); });
         for (LeafNode* leaf : made)
             copies.tree().addLeaf(leaf);
     }
@@ -191,7 +207,7 @@ class SampleSource {
 
 void SampleSource::copyAlso(const std::vector<LeafNode*>& leaves, const Staged& staged) {
     std::vector<LeafNode*> made(leaves.size());
-    tbb::parallel_for(std::size_t(0), leaves.size(), [&](std::size_t l) {
+    parallelFor(std::size_t(0), leaves.size(), [&](std::size_t l) {
         made[l] = new LeafNode(*leaves[l]);
         staged.forEachChanged(
             l, made[l]->buffer().data(),
@@ -263,29 +279,29 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 // squeezes) keeps a membrane a few voxels thick where the exact surface meets itself at one
 // point (the grid rounds off the funnels' tips), and the tear opens through it instead of
 // keeping it as the rim of the hole.
+// Per thread, what sampling a leaf uses: the block of source values around it, and its
+// voxels to sample with their places and pre-images.
+struct ResampleScratch {
+    SourceBlock block;
+    std::array<std::uint16_t, LeafNode::SIZE> at;
+    std::array<Eigen::Vector3d, LeafNode::SIZE> x, y;
+};
+using ResampleScratches = tbb::enumerable_thread_specific<ResampleScratch>;
+
 template <typename Map>
 std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const SampleSource& source,
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
                      const StepDeformation* tearing, double tornWindow, Sampling sampling,
-                     VoxelList& changed, Interrupter* interrupter,
+                     VoxelList& changed, Interrupter* interrupter, ResampleScratches& scratch,
                      const openvdb::MaskTree* only = nullptr, Staged* staged = nullptr) {
     // Per leaf, the voxels whose value changed (a word per x, as the leaf's mask holds them):
     // written by the leaf's own task, then listed.
     std::vector<leafwords::Words> changedWords(leaves.size());
-    if (staged) staged->values.reset(new float[leaves.size() * LeafNode::SIZE]);
     std::atomic<std::size_t> count{0};
-    // Per thread: the block of source values around a leaf, and the leaf's voxels to sample
-    // with their places and pre-images.
-    struct Scratch {
-        SourceBlock block;
-        std::array<std::uint16_t, LeafNode::SIZE> at;
-        std::array<Eigen::Vector3d, LeafNode::SIZE> x, y;
-    };
-    tbb::enumerable_thread_specific<Scratch> scratch;
     const VoxelPlacement place(grid.transform());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
         const SampleSource::Accessor acc(source);
-        Scratch& s = scratch.local();
+        ResampleScratch& s = scratch.local();
         SourceBlock& block = s.block;
         std::size_t n = 0;
         pollInterrupt(interrupter);
@@ -386,7 +402,7 @@ std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shel
     };
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> found;
     const tbb::blocked_range<int> slabs(box.min().x(), box.max().x() + 1);
-    tbb::parallel_for(slabs, [&](const auto& r) {
+    parallelFor(slabs, [&](const auto& r) {
         const SampleSource::Accessor acc(source);
         const auto live = grid.getConstAccessor();
         auto& out = found.local();
@@ -422,7 +438,7 @@ bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
                   const openvdb::CoordBBox& box) {
     using leafwords::Word;
     std::atomic<bool> all{true};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
         const auto acc = grid.getConstAccessor();
         for (std::size_t l = r.begin(); l != r.end() && all; ++l) {
             const LeafNode& leaf = *leaves[l];
@@ -478,7 +494,7 @@ void makeLeavesWithin(Grid& grid, const VoxelList& mask, int beyond,
     // thread (the tree changes): most of the up to 27 places a mask leaf reaches hold a leaf
     // already, and looking them all up on one thread was a serial part of every segment.
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> missing;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mask.size()), [&](const auto& r) {
+    parallelFor(tbb::blocked_range<std::size_t>(0, mask.size()), [&](const auto& r) {
         const auto acc = grid.getConstAccessor();
         auto& out = missing.local();
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -526,7 +542,7 @@ widening(const std::vector<const LeafNode*>& leaves, const std::vector<openvdb::
     // Every leaf against every asking one: the pairs are few where a stretch is local (some
     // 300 leaves against a few dozen in a needle segment at 1/128).
     std::vector<int> by(leaves.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
         for (std::size_t l = r.begin(); l != r.end(); ++l) {
             const openvdb::Coord o = leaves[l]->origin();
             for (const auto& [from, n] : asks) {
@@ -560,94 +576,170 @@ openvdb::CoordBBox indexBox(const Grid& grid, const Box& world, int pad) {
                               openvdb::Coord::ceil(hi).offsetBy(pad));
 }
 
-AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOptions& options,
-                          std::vector<openvdb::CoordBBox>* changedBoxes) {
-    AdvectStats stats;
-    stats.subSteps = seg.steps();
-    const double h = grid.voxelSize()[0];
-    const double halfWidth = halfWidthOf(grid);
-    const openvdb::CoordBBox region = indexBox(grid, seg.affectedBox(), 1);
-    // The images only pick voxels to activate: a hundredth of a voxel is plenty.
-    const double forwardTolerance = 0.01 * h / (1.0 + seg.affectedBox().max.cwiseAbs().maxCoeff());
+// A segment's state between its phases, and the scratch that outlives it.
+struct SegmentAdvector::Work {
+    // --- scratch kept from segment to segment ---------------------------------------------
+    std::atomic<std::size_t> growths{0}; // times one of the buffers below had to grow
+    std::vector<LeafNode::NodeMaskType> crossing;
+    std::vector<std::size_t> first;
+    std::vector<char> scanned;
+    std::vector<openvdb::Coord> interface;
+    std::vector<double> stretchAt;
+    // Per thread: the images it marked, and the points it maps a sub-step at a time.
+    struct Mapping {
+        VoxelList marked;
+        std::vector<Eigen::Vector3d> mapped, next;
+    };
+    tbb::enumerable_thread_specific<Mapping> mapping;
+    ResampleScratches resampling;
+    Staged staged;
 
-    // 1. Grow the band: forward-map the interface voxels, one sub-step at a time, and mark
-    //    every image; also measure how far apart the images of neighbouring voxels land
-    //    (the stretch), which bounds how far a pre-image can sit from the old surface.
-    auto t0 = Clock::now();
+    // --- the segment ------------------------------------------------------------------------
+    Grid* grid = nullptr;
+    const StepDeformation* seg = nullptr;
+    const AdvectOptions* options = nullptr;
+    AdvectStats stats;
+    double h = 0.0, halfWidth = 0.0, forwardTolerance = 0.0, tornWindow = 0.0;
+    openvdb::CoordBBox region, touched;
+    bool measureStretch = false;
+    int bandReach = 0, reach = 0;
+    VoxelList images, mask, fresh, changed, freed;
+    GridPtr widened; // the copies with the widened band, when it had to be widened
+    std::vector<LeafNode*> sampled, moving;
+
+    // Sizes a kept buffer for n entries, counting when its storage has to grow.
+    // A buffer that grows takes room for twice what is asked: the next segments of a stroke
+    // ask for about as much, a little more where the shape grew.
+    template <typename Vector> void fit(Vector& v, std::size_t n) {
+        if (n > v.capacity()) {
+            v.reserve(std::max(2 * n, 2 * v.capacity()));
+            ++growths;
+        }
+        v.resize(n);
+    }
+
+    void begin(Grid& g, const StepDeformation& s, const AdvectOptions& o) {
+        grid = &g;
+        seg = &s;
+        options = &o;
+        stats = AdvectStats{};
+        stats.subSteps = s.steps();
+        h = g.voxelSize()[0];
+        halfWidth = halfWidthOf(g);
+        region = indexBox(g, s.affectedBox(), 1);
+        // The images only pick voxels to activate: a hundredth of a voxel is plenty.
+        forwardTolerance = 0.01 * h / (1.0 + s.affectedBox().max.cwiseAbs().maxCoeff());
+        tornWindow = (std::ceil(halfWidth) + 1) * h; // see resample
+        bandReach = int(std::ceil(halfWidth)) + 1;
+        widened.reset();
+        for (VoxelList* list : {&images, &mask, &fresh, &changed, &freed})
+            list->clear();
+        sampled.clear();
+        moving.clear();
+    }
+
     // Leaves where the deformation is the identity (within a voxel of them: the stretch
     // reads half a voxel around an image) keep their values, and the band already covers
-    // their surface: only the interface of the other leaves is forward-mapped (the images
-    // of a moving leaf's surface reach into still leaves where they need a band).
-    const auto still = [&](const LeafNode& leaf) {
+    // their surface: only the interface of the other leaves is forward-mapped (the images of
+    // a moving leaf's surface reach into still leaves where they need a band).
+    bool still(const LeafNode& leaf) const {
         openvdb::CoordBBox box = leaf.getNodeBoundingBox();
         box.expand(1);
-        const openvdb::BBoxd world = grid.transform().indexToWorld(box);
-        return seg.identityOn(Box(toEigen(world.min()), toEigen(world.max())));
-    };
-    std::vector<openvdb::Coord> interface;
-    {
-        // Found leaf by leaf in parallel, then listed in leaf order (the stretch samples
-        // every fourth one of that list): each leaf's voxels counted first, then written
-        // where the counts before it put them (a list per leaf, joined on one thread, was a
-        // serial part of band growth).
-        const auto leaves = leavesIn(std::as_const(grid.tree()), region);
-        std::vector<LeafNode::NodeMaskType> crossing(leaves.size());
-        std::vector<std::size_t> first(leaves.size() + 1, 0);
-        std::vector<char> scanned(leaves.size(), 0);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
-            const auto acc = grid.getConstAccessor();
-            for (std::size_t l = r.begin(); l != r.end(); ++l) {
-                const LeafNode& leaf = *leaves[l];
-                if (still(leaf)) continue;
-                scanned[l] = 1;
-                // The active voxels next to the crossing, a word of the masks at a time (a
-                // leaf's 300 or so active voxels hold some 40 of them).
-                crossing[l] = crossingVoxels(leaf, acc);
-                crossing[l] &= leaf.getValueMask();
-                if (!region.isInside(leaf.getNodeBoundingBox()))
-                    for (auto it = crossing[l].beginOn(); it; ++it)
-                        if (!region.isInside(leaf.offsetToGlobalCoord(it.pos())))
-                            crossing[l].setOff(it.pos());
-                first[l + 1] = crossing[l].countOn();
-            }
-        });
-        for (std::size_t l = 0; l < leaves.size(); ++l) {
-            first[l + 1] += first[l];
-            if (!scanned[l]) continue;
-            ++stats.leavesVisited;
-            stats.voxelsVisited += leaves[l]->onVoxelCount();
-        }
-        interface.resize(first.back());
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
-            for (std::size_t l = r.begin(); l != r.end(); ++l) {
-                std::size_t i = first[l];
-                for (auto it = crossing[l].beginOn(); it; ++it)
-                    interface[i++] = leaves[l]->offsetToGlobalCoord(it.pos());
-            }
-        });
+        const openvdb::BBoxd world = grid->transform().indexToWorld(box);
+        return seg->identityOn(Box(toEigen(world.min()), toEigen(world.max())));
     }
-    stats.interfaceVoxels = interface.size();
-    // Each thread lists the images leaf by leaf, a list of its own, a run of interface voxels
-    // at a time; a leaf the runs share is listed by each (dilatedByCube joins the entries).
-    // Marked in a tree per thread, they cost a tree's look-up per image, and the trees had
-    // to be listed and freed after.
-    tbb::enumerable_thread_specific<VoxelList> marks;
-    const VoxelPlacement place(grid.transform());
+
     // The voxels the renormalization seeds from lie within 1.5 voxels of the new surface
     // (crossing ends and their central differences); their pre-images lie within
-    // 1.5 * stretch voxels of the old one, and trilinear sampling reads one voxel beyond.
-    // Make sure the old band reaches that far, so none of them reads a clamped value.
-    const auto neededFor = [](double stretch) {
+    // 1.5 * stretch voxels of the old one, and trilinear sampling reads one more voxel
+    // beyond. The old band must reach that far, so that none of them reads a clamped value.
+    static double neededFor(double stretch) {
         return std::ceil(1.5 * std::min(stretch, 32.0) + 1.0);
-    };
+    }
+
+    void findInterface();
+    void mapImages();
+    void widenSource();
+    void growBand();
+    void sample();
+    void fixSigns();
+    void renormalizeChanged();
+    void report(std::vector<openvdb::CoordBBox>* boxes) const;
+
+    VoxelList switchOn(const VoxelList& on);
+    void copyFar(const std::vector<LeafNode*>& leaves);
+    std::vector<LeafNode*> movingOf(const std::vector<LeafNode*>& leaves) const;
+    std::shared_ptr<SampleSource> sourceOfSubStep(int k);
+};
+
+// The interface voxels of the leaves the deformation moves: found leaf by leaf in parallel,
+// then listed in leaf order (the stretch samples every fourth one of that list), each leaf's
+// voxels counted first, then written where the counts before it put them (a list per leaf,
+// joined on one thread, would be a serial part of every segment).
+void SegmentAdvector::Work::findInterface() {
+    const auto leaves = leavesIn(std::as_const(grid->tree()), region);
+    fit(crossing, leaves.size());
+    fit(first, leaves.size() + 1);
+    fit(scanned, leaves.size());
+    first[0] = 0;
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
+        const auto acc = grid->getConstAccessor();
+        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const LeafNode& leaf = *leaves[l];
+            scanned[l] = 0;
+            crossing[l].setOff();
+            first[l + 1] = 0;
+            if (still(leaf)) continue;
+            scanned[l] = 1;
+            // The active voxels next to the crossing, a word of the masks at a time (a
+            // leaf's 300 or so active voxels hold some 40 of them).
+            crossing[l] = crossingVoxels(leaf, acc);
+            crossing[l] &= leaf.getValueMask();
+            if (!region.isInside(leaf.getNodeBoundingBox()))
+                for (auto it = crossing[l].beginOn(); it; ++it)
+                    if (!region.isInside(leaf.offsetToGlobalCoord(it.pos())))
+                        crossing[l].setOff(it.pos());
+            first[l + 1] = crossing[l].countOn();
+        }
+    });
+    for (std::size_t l = 0; l < leaves.size(); ++l) {
+        first[l + 1] += first[l];
+        if (!scanned[l]) continue;
+        ++stats.leavesVisited;
+        stats.voxelsVisited += leaves[l]->onVoxelCount();
+    }
+    fit(interface, first[leaves.size()]);
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
+        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            std::size_t i = first[l];
+            for (auto it = crossing[l].beginOn(); it; ++it)
+                interface[i++] = leaves[l]->offsetToGlobalCoord(it.pos());
+        }
+    });
+    stats.interfaceVoxels = interface.size();
+}
+
+// Forward-maps the interface voxels, one sub-step at a time, and marks every image; measures
+// how far apart the images of neighbouring voxels land (the stretch), which bounds how far a
+// pre-image can sit from the old surface. Each thread lists the images leaf by leaf, a list
+// of its own, a run of interface voxels at a time; a leaf the runs share is listed by each
+// (dilatedByCube joins the entries). Marked in a tree per thread, they would cost a tree's
+// look-up per image, and the trees would have to be listed and freed after.
+void SegmentAdvector::Work::mapImages() {
+    for (Mapping& m : mapping)
+        m.marked.clear();
+    const VoxelPlacement place(grid->transform());
     // The stretch at every kStretchSampling-th interface voxel (1 where not measured), unless
     // the deformation's bound shows that the band is wide enough wherever it is measured
-    // (the drag's segments: 43,000 inverse maps and eigenvalue solves a segment at 1/128).
-    const bool measureStretch = neededFor(seg.stretchBound()) > halfWidth;
-    std::vector<double> stretchAt(interface.size() / kStretchSampling + 1, 1.0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
-        pollInterrupt(options.interrupter);
-        VoxelList& marked = marks.local();
+    // (a drag's segments, where measuring would cost inverse maps and an eigenvalue solve at
+    // every sampled voxel for nothing).
+    measureStretch = neededFor(seg->stretchBound()) > halfWidth;
+    fit(stretchAt, interface.size() / kStretchSampling + 1);
+    std::fill(stretchAt.begin(), stretchAt.end(), 1.0);
+    parallelFor(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
+        pollInterrupt(options->interrupter);
+        Mapping& m = mapping.local();
+        VoxelList& marked = m.marked;
         const std::size_t run = marked.size(); // this run's entries start here
         // The images of a run of voxels next to each other fall into a few leaves: its
         // entries are searched from the one marked last.
@@ -663,293 +755,368 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& seg, const AdvectOp
             const openvdb::Index off = LeafNode::coordToOffset(c);
             marked[last].words[off >> 6] |= leafwords::Word(1) << (off & 63);
         };
-        // The range's voxels are mapped a sub-step at a time, all at once.
-        thread_local std::vector<Eigen::Vector3d> mapped, next;
-        mapped.resize(r.size());
-        next.resize(r.size());
-        for (std::size_t i = r.begin(); i != r.end(); ++i)
-            mapped[i - r.begin()] = toEigen(place.toWorld(interface[i].asVec3d()));
-        for (int k = 0; k < seg.steps(); ++k) {
-            seg.forwardSteps(k, mapped.data(), mapped.size(), forwardTolerance, next.data());
-            mapped.swap(next);
-            // Intermediate surfaces only need a band when they are stored.
-            if (options.resampleEachSubStep || k + 1 == seg.steps())
-                for (const Eigen::Vector3d& p : mapped)
-                    mark(openvdb::Coord::round(place.toIndex(toVdb(p))));
+        // The range's voxels are mapped a sub-step at a time, a batch of them at once (a
+        // batch of fixed size, so that the buffers need no more room however the loop is
+        // split among the threads).
+        std::vector<Eigen::Vector3d>&mapped = m.mapped, &next = m.next;
+        const std::size_t before = marked.capacity();
+        if (mapped.capacity() < kMapBatch) {
+            mapped.reserve(kMapBatch);
+            next.reserve(kMapBatch);
+            ++growths;
         }
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const Eigen::Vector3d& p = mapped[i - r.begin()];
-            if (!measureStretch || i % kStretchSampling != 0) continue;
-            // How far the inverse map can spread a voxel-sized neighbourhood of the new
-            // surface: the largest singular value of its Jacobian.
-            Eigen::Matrix3d J;
-            for (int a = 0; a < 3; ++a) {
-                Eigen::Vector3d e = Eigen::Vector3d::Zero();
-                e[a] = 0.5 * h;
-                J.col(a) = (seg.inverseMap(p + e) - seg.inverseMap(p - e)) / h;
+        for (std::size_t b = r.begin(); b < r.end(); b += kMapBatch) {
+            const std::size_t e = std::min(b + kMapBatch, r.end());
+            mapped.resize(e - b);
+            next.resize(e - b);
+            for (std::size_t i = b; i != e; ++i)
+                mapped[i - b] = toEigen(place.toWorld(interface[i].asVec3d()));
+            for (int k = 0; k < seg->steps(); ++k) {
+                seg->forwardSteps(k, mapped.data(), mapped.size(), forwardTolerance, next.data());
+                mapped.swap(next);
+                // Intermediate surfaces only need a band when they are stored.
+                if (options->resampleEachSubStep || k + 1 == seg->steps())
+                    for (const Eigen::Vector3d& p : mapped)
+                        mark(openvdb::Coord::round(place.toIndex(toVdb(p))));
             }
-            // Its square is the largest eigenvalue of J^T J, solved in closed form (an
-            // iterative SVD of J cost more than the six inverse maps).
-            Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
-            eigen.computeDirect(J.transpose() * J, Eigen::EigenvaluesOnly);
-            stretchAt[i / kStretchSampling] = std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
+            for (std::size_t i = b; i != e; ++i) {
+                const Eigen::Vector3d& p = mapped[i - b];
+                if (!measureStretch || i % kStretchSampling != 0) continue;
+                // How far the inverse map can spread a voxel-sized neighbourhood of the new
+                // surface: the largest singular value of its Jacobian.
+                Eigen::Matrix3d J;
+                for (int a = 0; a < 3; ++a) {
+                    Eigen::Vector3d e = Eigen::Vector3d::Zero();
+                    e[a] = 0.5 * h;
+                    J.col(a) = (seg->inverseMap(p + e) - seg->inverseMap(p - e)) / h;
+                }
+                // Its square is the largest eigenvalue of J^T J, solved in closed form (an
+                // iterative SVD of J costs more than the six inverse maps).
+                Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+                eigen.computeDirect(J.transpose() * J, Eigen::EigenvaluesOnly);
+                stretchAt[i / kStretchSampling] = std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
+            }
         }
+        if (marked.capacity() > before) ++growths;
     });
-    // The images, from each thread's list.
-    VoxelList images;
-    for (const VoxelList& marked : marks)
-        images.insert(images.end(), marked.begin(), marked.end());
-    // The band the images are dilated into, sampled: what renormalization's seeds read (the
-    // voxels next to the new crossing and their face neighbours) lies within kSeedReach of
-    // them, and sampling is checked to have reached it all (else the images are dilated as
-    // far as the whole band reaches, `bandReach`). Renormalization gives the voxels between
-    // there and the band's edge their distances: sampling them too, as dilating the images
-    // by the whole band did, read about twice as many voxels as the band holds.
-    const int bandReach = int(std::ceil(halfWidth)) + 1;
-    const int reach = options.resampleEachSubStep ? bandReach : std::min(kSeedReach, bandReach);
-    VoxelList mask = dilatedByCube(images, reach);
-    stats.sampledReach = reach;
-    // A tear opens empty space where there was material: no image of the surface reaches
-    // the middle of the opening, so the inside voxels there join the band to be sampled
-    // (renormalization drops them again, with their new sign).
-    if (seg.tears()) stats.tornVoxels = markOpened(grid, seg, (halfWidth + 2) * h, mask);
+    // Each thread's list keeps room for twice what it marked this time.
+    for (Mapping& m : mapping)
+        if (m.marked.capacity() < 2 * m.marked.size()) m.marked.reserve(2 * m.marked.size());
+    std::size_t count = 0;
+    for (const Mapping& m : mapping)
+        count += m.marked.size();
+    fit(images, 0);
+    if (count > images.capacity()) {
+        images.reserve(std::max(2 * count, 2 * images.capacity()));
+        ++growths;
+    }
+    for (const Mapping& m : mapping)
+        images.insert(images.end(), m.marked.begin(), m.marked.end());
     if (measureStretch)
         stats.stretchSamples = (interface.size() + kStretchSampling - 1) / kStretchSampling;
+}
+
+// Where the stretch asks for more band than the grid has: only the affected box is sampled,
+// so the band is widened there alone. Copies of its leaves, whose inactive values (now
+// +-needed voxels) carry the signs, take the band dilated by the missing voxels, and fast
+// marching fills in distances.
+void SegmentAdvector::Work::widenSource() {
     const double needed = neededFor(*std::max_element(stretchAt.begin(), stretchAt.end()));
     stats.widenedTo = std::max(halfWidth, needed);
-    GridPtr widened; // the copies with the widened band, when it had to be widened
-    if (needed > halfWidth) {
-        // Only the affected box is sampled, so the band is widened there alone: copies of
-        // its leaves, whose inactive values (now +-needed voxels) carry the signs, take the
-        // band dilated by the missing voxels, and fast marching fills in distances.
-        const openvdb::CoordBBox box = indexBox(grid, seg.affectedBox(), int(needed) + 3);
-        const auto leaves = leavesIn(std::as_const(grid.tree()), box);
-        GridPtr source = SampleSource::copyLeaves(grid, leaves);
-        stats.leavesCopied += leaves.size();
-        openvdb::tools::changeLevelSetBackground(source->tree(), float(needed * h));
-        // A stretch is strong only near where a tool tears or squeezes (the tips of the pinch's
-        // needles, the noose): the band is widened as far as the stretch measured near each
-        // leaf asks, and not at all where none asks (in a needle segment of the first pinch of
-        // data/two_handles.json at 1/128, some 300 leaves of band lie in the box, and a dozen
-        // ask for more than the band holds).
-        const std::vector<int> by = widening(leaves, interface, stretchAt, neededFor, halfWidth);
-        std::map<int, openvdb::MaskTree> widen; // the leaves to widen, by how far
-        for (std::size_t l = 0; l < leaves.size(); ++l) {
-            if (by[l] == 0) continue;
-            widen[by[l]].touchLeaf(leaves[l]->origin())->topologyUnion(*leaves[l]);
-            ++stats.leavesWidened;
-        }
-        for (auto& [steps, mask] : widen) {
-            openvdb::tools::dilateActiveValues(mask, steps, openvdb::tools::NN_FACE,
-                                               openvdb::tools::IGNORE_TILES);
-            source->tree().topologyUnion(mask);
-        }
-        // Leaves the dilation added hold the copies' background, whatever the side.
-        const auto live = grid.getConstAccessor();
-        for (LeafNode* leaf : leavesIn(source->tree(), box))
-            if (!grid.tree().probeConstLeaf(leaf->origin())) // not a copy
-                farWithSigns(*leaf, float(needed * h), live);
-        renormalize(*source, indexBox(grid, seg.affectedBox(), int(needed) + 1), FmmOrder::First,
-                    options.interrupter);
-        widened = source;
+    if (needed <= halfWidth) return;
+    const openvdb::CoordBBox box = indexBox(*grid, seg->affectedBox(), int(needed) + 3);
+    const auto leaves = leavesIn(std::as_const(grid->tree()), box);
+    GridPtr source = SampleSource::copyLeaves(*grid, leaves);
+    stats.leavesCopied += leaves.size();
+    openvdb::tools::changeLevelSetBackground(source->tree(), float(needed * h));
+    // A stretch is strong only near where a tool tears or squeezes (the tips of the pinch's
+    // needles, the noose): the band is widened as far as the stretch measured near each leaf
+    // asks, and not at all where none asks (in a needle segment of a pinch, a few leaves of
+    // the hundreds in the box ask for more than the band holds).
+    const std::vector<int> by = widening(leaves, interface, stretchAt, neededFor, halfWidth);
+    std::map<int, openvdb::MaskTree> widen; // the leaves to widen, by how far
+    for (std::size_t l = 0; l < leaves.size(); ++l) {
+        if (by[l] == 0) continue;
+        widen[by[l]].touchLeaf(leaves[l]->origin())->topologyUnion(*leaves[l]);
+        ++stats.leavesWidened;
     }
-    // Voxels the band grows into (renormalized, or dropped again, wherever they are): the
-    // mask's voxels not yet on in the grid. The grid's leaves are found (or made) on this
-    // thread, through an accessor (entries next to each other in the list mostly lie in one
-    // internal node); the voxels are switched on a leaf and a word at a time in parallel (the
-    // mask lists each leaf once, so no two tasks write one leaf).
-    const auto switchOn = [&](const VoxelList& on) {
-        std::vector<const LeafVoxels*> from;
-        std::vector<LeafNode*> to;
-        {
-            auto into = grid.getAccessor();
-            for (const LeafVoxels& leaf : on) {
-                if (!leafwords::any(leaf.words)) continue;
-                from.push_back(&leaf);
-                to.push_back(into.touchLeaf(leaf.origin));
-            }
-        }
-        std::vector<leafwords::Words> newlyOn(from.size());
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, from.size()), [&](const auto& r) {
-            for (std::size_t i = r.begin(); i != r.end(); ++i) {
-                auto& words = to[i]->getValueMask();
-                for (int x = 0; x < 8; ++x) {
-                    const std::uint64_t add = from[i]->words[std::size_t(x)];
-                    newlyOn[i][std::size_t(x)] = add & ~words.getWord<std::uint64_t>(x);
-                    words.getWord<std::uint64_t>(x) |= add;
-                }
-            }
-        });
-        VoxelList newly;
-        for (std::size_t i = 0; i < from.size(); ++i)
-            if (leafwords::any(newlyOn[i])) newly.push_back({from[i]->origin, newlyOn[i]});
-        return newly;
-    };
-    VoxelList fresh = switchOn(mask);
-    stats.growSeconds = secondsSince(t0);
+    for (auto& [steps, toWiden] : widen) {
+        openvdb::tools::dilateActiveValues(toWiden, steps, openvdb::tools::NN_FACE,
+                                           openvdb::tools::IGNORE_TILES);
+        source->tree().topologyUnion(toWiden);
+    }
+    // Leaves the dilation added hold the copies' background, whatever the side.
+    const auto live = grid->getConstAccessor();
+    for (LeafNode* leaf : leavesIn(source->tree(), box))
+        if (!grid->tree().probeConstLeaf(leaf->origin())) // not a copy
+            farWithSigns(*leaf, float(needed * h), live);
+    renormalize(*source, indexBox(*grid, seg->affectedBox(), int(needed) + 1), FmmOrder::First,
+                options->interrupter);
+    widened = source;
+}
 
-    // 2. Sample: composed inverse (default) or one resample per sub-step (5.3.4).
-    t0 = Clock::now();
-    VoxelList changed;
-    std::vector<LeafNode*> sampled = leavesIn(grid.tree(), region);
+// The voxels of `on` not yet on in the grid, switched on and returned: those the band grows
+// into (renormalized, or dropped again, wherever they are). The grid's leaves are found (or
+// made) on this thread, through an accessor (entries next to each other in the list mostly
+// lie in one internal node); the voxels are switched on a leaf and a word at a time in
+// parallel (the list holds each leaf once, so no two tasks write one leaf).
+VoxelList SegmentAdvector::Work::switchOn(const VoxelList& on) {
+    std::vector<const LeafVoxels*> from;
+    std::vector<LeafNode*> to;
+    {
+        auto into = grid->getAccessor();
+        for (const LeafVoxels& leaf : on) {
+            if (!leafwords::any(leaf.words)) continue;
+            from.push_back(&leaf);
+            to.push_back(into.touchLeaf(leaf.origin));
+        }
+    }
+    std::vector<leafwords::Words> newlyOn(from.size());
+    parallelFor(tbb::blocked_range<std::size_t>(0, from.size()), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i) {
+            auto& words = to[i]->getValueMask();
+            for (int x = 0; x < 8; ++x) {
+                const std::uint64_t add = from[i]->words[std::size_t(x)];
+                newlyOn[i][std::size_t(x)] = add & ~words.getWord<std::uint64_t>(x);
+                words.getWord<std::uint64_t>(x) |= add;
+            }
+        }
+    });
+    VoxelList newly;
+    for (std::size_t i = 0; i < from.size(); ++i)
+        if (leafwords::any(newlyOn[i])) newly.push_back({from[i]->origin, newlyOn[i]});
+    return newly;
+}
+
+// The band the images are dilated into, switched on: what renormalization's seeds read (the
+// voxels next to the new crossing and their face neighbours) lies within kSeedReach of them,
+// and sampling checks that it reached it all (else sample() dilates the images as far as the
+// whole band reaches). Renormalization gives the voxels between there and the band's edge
+// their distances: sampling them too would read about twice as many voxels as the band holds.
+void SegmentAdvector::Work::growBand() {
+    reach = options->resampleEachSubStep ? bandReach : std::min(kSeedReach, bandReach);
+    mask = dilatedByCube(images, reach);
+    stats.sampledReach = reach;
+    // A tear opens empty space where there was material: no image of the surface reaches the
+    // middle of the opening, so the inside voxels there join the band to be sampled
+    // (renormalization drops them again, with their new sign).
+    if (seg->tears()) stats.tornVoxels = markOpened(*grid, *seg, (halfWidth + 2) * h, mask);
+    fresh = switchOn(mask);
+}
+
+// Leaves the band just grew into, outside the widened copies: sampling writes them, so it
+// must not read them from the live grid, which still holds their tiles' signs.
+void SegmentAdvector::Work::copyFar(const std::vector<LeafNode*>& leaves) {
+    const auto live = grid->getConstAccessor();
+    for (const LeafNode* leaf : leaves) {
+        if (widened->tree().probeConstLeaf(leaf->origin())) continue;
+        auto* copy = new LeafNode(*leaf);
+        farWithSigns(*copy, widened->background(), live);
+        widened->tree().addLeaf(copy);
+        ++stats.leavesCopied;
+    }
+}
+
+// Only leaves the deformation moves are resampled (and copied before they are written):
+// elsewhere a sample at a voxel centre gives back its own value. A widened band is the
+// exception: its values differ from the grid's, so every leaf is resampled from it.
+std::vector<LeafNode*> SegmentAdvector::Work::movingOf(const std::vector<LeafNode*>& leaves) const {
+    std::vector<char> moves(leaves.size(), 1);
+    if (!widened)
+        parallelFor(std::size_t(0), leaves.size(),
+                    [&](std::size_t l) { moves[l] = !still(*leaves[l]); });
+    std::vector<LeafNode*> out;
+    for (std::size_t l = 0; l < leaves.size(); ++l)
+        if (moves[l]) out.push_back(leaves[l]);
+    return out;
+}
+
+// What sub-step k samples when they are sampled one at a time: the grid with copies of what
+// they write (the first, from a widened band, its copies).
+std::shared_ptr<SampleSource> SegmentAdvector::Work::sourceOfSubStep(int k) {
+    if (widened && k == 0) return std::make_shared<SampleSource>(*grid, widened);
+    auto copy = SampleSource::copyOnWrite(*grid, moving);
+    stats.leavesCopied += moving.size();
+    return copy;
+}
+
+// Samples the moving leaves at their pre-images: the composed inverse (default) or one
+// resample per sub-step (5.3.4).
+void SegmentAdvector::Work::sample() {
+    sampled = leavesIn(grid->tree(), region);
     stats.leavesVisited += sampled.size();
-    // Leaves the band just grew into, outside the widened copies: sampling writes them, so it
-    // must not read them from the live grid, which still holds their tiles' signs.
-    const auto copyFar = [&](const std::vector<LeafNode*>& leaves) {
-        const auto live = grid.getConstAccessor();
-        for (const LeafNode* leaf : leaves) {
-            if (widened->tree().probeConstLeaf(leaf->origin())) continue;
-            auto* copy = new LeafNode(*leaf);
-            farWithSigns(*copy, widened->background(), live);
-            widened->tree().addLeaf(copy);
-            ++stats.leavesCopied;
-        }
-    };
     if (widened) copyFar(sampled);
-    // Only leaves the deformation moves are resampled (and copied before they are written):
-    // elsewhere a sample at a voxel centre gives back its own value. A widened band is the
-    // exception: its values differ from the grid's, so every leaf is resampled from it.
-    const auto movingOf = [&](const std::vector<LeafNode*>& leaves) {
-        std::vector<char> moves(leaves.size(), 1);
-        if (!widened)
-            tbb::parallel_for(std::size_t(0), leaves.size(),
-                              [&](std::size_t l) { moves[l] = !still(*leaves[l]); });
-        std::vector<LeafNode*> out;
-        for (std::size_t l = 0; l < leaves.size(); ++l)
-            if (moves[l]) out.push_back(leaves[l]);
-        return out;
-    };
-    std::vector<LeafNode*> moving = movingOf(sampled);
-    // (The sources of the sub-steps one at a time: the grid with copies of what they write.)
-    auto source = [&](int k) {
-        if (widened && k == 0) return std::make_shared<SampleSource>(grid, widened);
-        auto copy = SampleSource::copyOnWrite(grid, moving);
-        stats.leavesCopied += moving.size();
-        return copy;
-    };
-    // Inactive voxels of the resampled leaves kept their old values, whose signs may now be
-    // wrong (space pulled out of the shape is inside it now): their signs, and those of the
-    // tiles around them, are re-derived from the band. Other leaves did not change.
-    const openvdb::CoordBBox touched = changedRegion(grid, seg);
-    const double tornWindow = (std::ceil(halfWidth) + 1) * h; // see resample
-    if (!options.resampleEachSubStep) {
-        const auto map = [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y) {
-            seg.inverseMaps(x, n, y);
-        };
-        // Sampling reads the grid itself and writes beside it (staged), or, from a widened
-        // band, reads the copies that hold it and writes into the grid.
-        const auto from =
-            widened ? std::make_shared<SampleSource>(grid, widened) : SampleSource::live(grid);
-        Staged staged;
-        stats.sampledVoxels = resample(
-            grid, moving, *from, !widened, region, map, seg.tears() ? &seg : nullptr, tornWindow,
-            options.sampling, changed, options.interrupter, nullptr, widened ? nullptr : &staged);
-        if (!widened) {
-            staged.swapInto(moving);
-            stats.leavesCopied += moving.size();
-        }
-        if (reach < bandReach && !seedsSampled(grid, moving, region)) {
-            // A strong stretch spread the images apart: the images are dilated as far as the
-            // band reaches, and the voxels that adds are sampled from the same source (the
-            // leaves it adds copied first, while they still hold their tiles' values). The
-            // leaves sampled already are copied as sampling found them, their values and
-            // their active voxels, before the band grows: their old values are staged now.
-            if (!widened) from->copyAlso(moving, staged);
-            mask = dilatedByCube(mask, bandReach - reach);
-            stats.sampledReach = bandReach;
-            const VoxelList added = switchOn(mask);
-            fresh.insert(fresh.end(), added.begin(), added.end());
-            openvdb::MaskTree addedTree;
-            uniteMasks(addedTree, added);
-            std::vector<LeafNode*> all = leavesIn(grid.tree(), region), grown;
-            // `sampled` is in the tree's order, and the tree only gained leaves.
-            for (std::size_t i = 0, j = 0; i < all.size(); ++i) {
-                if (j < sampled.size() && all[i] == sampled[j])
-                    ++j;
-                else
-                    grown.push_back(all[i]);
-            }
-            stats.leavesVisited += grown.size();
-            const std::vector<LeafNode*> movingGrown = movingOf(grown);
-            if (widened) {
-                copyFar(grown);
-            } else {
-                from->copyAlso(movingGrown);
-                stats.leavesCopied += movingGrown.size();
-            }
-            moving.insert(moving.end(), movingGrown.begin(), movingGrown.end());
-            stats.sampledVoxels +=
-                resample(grid, moving, *from, !widened, region, map, seg.tears() ? &seg : nullptr,
-                         tornWindow, options.sampling, changed, options.interrupter, &addedTree);
-            sampled = std::move(all);
-        }
-        from->freeCopies();
-    } else {
+    moving = movingOf(sampled);
+    touched = changedRegion(*grid, *seg);
+    const StepDeformation* tearing = seg->tears() ? seg : nullptr;
+    if (options->resampleEachSubStep) {
         // Each sub-step reads what the one before wrote, inactive values included, so their
         // signs are re-derived before it reads them: otherwise a pre-image beyond the band
         // takes the sign its place had before the earlier sub-steps moved the surface.
-        for (int k = 0; k < seg.steps(); ++k) {
-            if (k > 0) stats.leavesFlooded += floodSignsIn(grid.tree(), moving, touched);
-            const auto from = source(k);
+        for (int k = 0; k < seg->steps(); ++k) {
+            if (k > 0) stats.leavesFlooded += floodSignsIn(grid->tree(), moving, touched);
+            const auto from = sourceOfSubStep(k);
             stats.sampledVoxels += resample(
-                grid, moving, *from, !widened || k > 0, region,
+                *grid, moving, *from, !widened || k > 0, region,
                 [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y) {
                     for (std::size_t i = 0; i < n; ++i)
-                        y[i] = seg.inverseStep(k, x[i]);
+                        y[i] = seg->inverseStep(k, x[i]);
                 },
-                seg.tears() ? &seg : nullptr, tornWindow, options.sampling, changed,
-                options.interrupter);
+                tearing, tornWindow, options->sampling, changed, options->interrupter, resampling);
             from->freeCopies();
         }
+        return;
     }
-    stats.voxelsVisited += stats.sampledVoxels;
-    stats.leavesFlooded += floodSignsIn(grid.tree(), moving, touched);
-    // The band's outer voxels may lie in leaves no sample reached: those leaves are made now,
-    // after the signs were re-derived, so that they take the sign of the tile they replace.
-    if (stats.sampledReach < bandReach)
-        makeLeavesWithin(grid, mask, bandReach - stats.sampledReach, touched);
-    stats.sampleSeconds = secondsSince(t0);
-
-    // 3. Renormalize the changed region (and the band around it).
-    t0 = Clock::now();
-    // Where renormalization frees voxels: the changed ones dilated, and the fresh ones.
-    VoxelList freed;
-    if (options.renormalize) {
-        // Only where values changed, and as far as the band reaches from there (the nearest
-        // surface of a voxel nearby may have moved): where the deformation is the identity
-        // (outside the tools' coatings, which fill only part of the box) the distances hold.
-        freed = dilatedByCube(changed, int(std::ceil(halfWidth)) + 1);
-        freed.insert(freed.end(), fresh.begin(), fresh.end());
-        const FmmStats fmm =
-            renormalize(grid, touched, freed, options.renormalization, options.interrupter);
-        stats.leavesVisited += fmm.leaves;
-        stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
+    const auto map = [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y) {
+        seg->inverseMaps(x, n, y);
+    };
+    // Sampling reads the grid itself and writes beside it (staged), or, from a widened band,
+    // reads the copies that hold it and writes into the grid.
+    const auto from =
+        widened ? std::make_shared<SampleSource>(*grid, widened) : SampleSource::live(*grid);
+    if (!widened) staged.reserve(moving.size(), growths);
+    stats.sampledVoxels = resample(*grid, moving, *from, !widened, region, map, tearing, tornWindow,
+                                   options->sampling, changed, options->interrupter, resampling,
+                                   nullptr, widened ? nullptr : &staged);
+    if (!widened) {
+        staged.swapInto(moving);
+        stats.leavesCopied += moving.size();
     }
-    stats.renormalizeSeconds = secondsSince(t0);
-    stats.touched = touched;
-    if (changedBoxes) {
-        // Sampling changed the band's voxels in `changed` and switched on those of `fresh`;
-        // renormalization, where it ran, wrote within `freed` and one step past it, where the
-        // band may grow. The sign floods and the pruning of emptied leaves change inactive
-        // values only.
-        changedBoxes->clear();
-        const auto addBox = [&](const openvdb::Coord& o, const leafwords::Words& on, int margin) {
-            if (!leafwords::any(on)) return;
-            int lo[3], hi[3];
-            leafwords::bounds(on, lo, hi);
-            changedBoxes->emplace_back(o.offsetBy(lo[0] - margin, lo[1] - margin, lo[2] - margin),
-                                       o.offsetBy(hi[0] + margin, hi[1] + margin, hi[2] + margin));
-        };
-        if (options.renormalize) {
-            for (const LeafVoxels& leaf : freed)
-                addBox(leaf.origin, leaf.words, 1);
-        } else {
-            for (const VoxelList* list : {&changed, &fresh})
-                for (const LeafVoxels& leaf : *list)
-                    addBox(leaf.origin, leaf.words, 0);
+    if (reach < bandReach && !seedsSampled(*grid, moving, region)) {
+        // A strong stretch spread the images apart: the images are dilated as far as the band
+        // reaches, and the voxels that adds are sampled from the same source (the leaves it
+        // adds copied first, while they still hold their tiles' values). The leaves sampled
+        // already are copied as sampling found them, their values and their active voxels,
+        // before the band grows: their old values are staged now.
+        if (!widened) from->copyAlso(moving, staged);
+        mask = dilatedByCube(mask, bandReach - reach);
+        stats.sampledReach = bandReach;
+        const VoxelList added = switchOn(mask);
+        fresh.insert(fresh.end(), added.begin(), added.end());
+        openvdb::MaskTree addedTree;
+        uniteMasks(addedTree, added);
+        std::vector<LeafNode*> all = leavesIn(grid->tree(), region), grown;
+        // `sampled` is in the tree's order, and the tree only gained leaves.
+        for (std::size_t i = 0, j = 0; i < all.size(); ++i) {
+            if (j < sampled.size() && all[i] == sampled[j])
+                ++j;
+            else
+                grown.push_back(all[i]);
         }
+        stats.leavesVisited += grown.size();
+        const std::vector<LeafNode*> movingGrown = movingOf(grown);
+        if (widened) {
+            copyFar(grown);
+        } else {
+            from->copyAlso(movingGrown);
+            stats.leavesCopied += movingGrown.size();
+        }
+        moving.insert(moving.end(), movingGrown.begin(), movingGrown.end());
+        stats.sampledVoxels +=
+            resample(*grid, moving, *from, !widened, region, map, tearing, tornWindow,
+                     options->sampling, changed, options->interrupter, resampling, &addedTree);
+        sampled = std::move(all);
     }
-    return stats;
+    from->freeCopies();
+}
+
+// Inactive voxels of the resampled leaves kept their old values, whose signs may now be wrong
+// (space pulled out of the shape is inside it now): their signs, and those of the tiles
+// around them, are re-derived from the band. Other leaves did not change. The band's outer
+// voxels may lie in leaves no sample reached: those leaves are made now, after the signs were
+// re-derived, so that they take the sign of the tile they replace.
+void SegmentAdvector::Work::fixSigns() {
+    stats.voxelsVisited += stats.sampledVoxels;
+    stats.leavesFlooded += floodSignsIn(grid->tree(), moving, touched);
+    if (stats.sampledReach < bandReach)
+        makeLeavesWithin(*grid, mask, bandReach - stats.sampledReach, touched);
+}
+
+// Renormalizes only where values changed, and as far as the band reaches from there (the
+// nearest surface of a voxel nearby may have moved): where the deformation is the identity
+// (outside the tools' coatings, which fill only part of the box) the distances hold. The
+// voxels the band grew into are freed too.
+void SegmentAdvector::Work::renormalizeChanged() {
+    if (!options->renormalize) return;
+    freed = dilatedByCube(changed, int(std::ceil(halfWidth)) + 1);
+    freed.insert(freed.end(), fresh.begin(), fresh.end());
+    const FmmStats fmm =
+        renormalize(*grid, touched, freed, options->renormalization, options->interrupter);
+    stats.leavesVisited += fmm.leaves;
+    stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
+}
+
+// Sampling changed the band's voxels in `changed` and switched on those of `fresh`;
+// renormalization, where it ran, wrote within `freed` and one step past it, where the band
+// may grow. The sign floods and the pruning of emptied leaves change inactive values only.
+void SegmentAdvector::Work::report(std::vector<openvdb::CoordBBox>* boxes) const {
+    if (!boxes) return;
+    boxes->clear();
+    const auto addBox = [&](const openvdb::Coord& o, const leafwords::Words& on, int margin) {
+        if (!leafwords::any(on)) return;
+        int lo[3], hi[3];
+        leafwords::bounds(on, lo, hi);
+        boxes->emplace_back(o.offsetBy(lo[0] - margin, lo[1] - margin, lo[2] - margin),
+                            o.offsetBy(hi[0] + margin, hi[1] + margin, hi[2] + margin));
+    };
+    if (options->renormalize) {
+        for (const LeafVoxels& leaf : freed)
+            addBox(leaf.origin, leaf.words, 1);
+    } else {
+        for (const VoxelList* list : {&changed, &fresh})
+            for (const LeafVoxels& leaf : *list)
+                addBox(leaf.origin, leaf.words, 0);
+    }
+}
+
+SegmentAdvector::SegmentAdvector() : work_(std::make_unique<Work>()) {}
+SegmentAdvector::~SegmentAdvector() = default;
+SegmentAdvector::SegmentAdvector(SegmentAdvector&&) noexcept = default;
+SegmentAdvector& SegmentAdvector::operator=(SegmentAdvector&&) noexcept = default;
+
+std::size_t SegmentAdvector::scratchGrowths() const {
+    return work_->growths;
+}
+
+AdvectStats SegmentAdvector::run(Grid& grid, const StepDeformation& segment,
+                                 const AdvectOptions& options,
+                                 std::vector<openvdb::CoordBBox>* changed) {
+    Work& w = *work_;
+    w.begin(grid, segment, options);
+    {
+        const SerialClock clock;
+        w.findInterface();
+        w.mapImages();
+        w.widenSource();
+        w.growBand();
+        w.stats.growSeconds = clock.wallSeconds();
+        w.stats.growSerialSeconds = clock.serialSeconds();
+    }
+    {
+        const SerialClock clock;
+        w.sample();
+        w.fixSigns();
+        w.stats.sampleSeconds = clock.wallSeconds();
+        w.stats.sampleSerialSeconds = clock.serialSeconds();
+    }
+    {
+        const SerialClock clock;
+        w.renormalizeChanged();
+        w.stats.renormalizeSeconds = clock.wallSeconds();
+        w.stats.renormalizeSerialSeconds = clock.serialSeconds();
+    }
+    w.stats.touched = w.touched;
+    w.report(changed);
+    // What the segment holds of the grid goes: the next one starts from the grid alone.
+    w.widened.reset();
+    w.sampled.clear();
+    w.moving.clear();
+    return w.stats;
+}
+
+AdvectStats advectSegment(Grid& grid, const StepDeformation& segment, const AdvectOptions& options,
+                          std::vector<openvdb::CoordBBox>* changed) {
+    return SegmentAdvector().run(grid, segment, options, changed);
 }
 
 } // namespace sweepers

@@ -18,6 +18,7 @@
 // flood fill and the box is renormalized.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "deform/step_deformation.h"
@@ -53,14 +54,51 @@ struct AdvectStats {
     std::size_t leavesFlooded = 0; // whose inactive signs were re-derived
     std::size_t tornVoxels = 0;    // inside voxels beyond the band that a tear opened
     double growSeconds = 0.0, sampleSeconds = 0.0, renormalizeSeconds = 0.0;
+    // Of each, the time one thread worked while the others waited (levelset/parallel.h):
+    // what more cores cannot shorten.
+    double growSerialSeconds = 0.0, sampleSerialSeconds = 0.0, renormalizeSerialSeconds = 0.0;
     openvdb::CoordBBox touched; // index box whose values may have changed
 };
 
-// With `changed`, it is given boxes (each within a voxel of one leaf) that hold every voxel
+// The step of one segment, as a class whose phases run in order:
+//   findInterface  the interface voxels of the leaves the deformation moves;
+//   mapImages      their images, forward-mapped sub-step by sub-step, and the stretch of
+//                  the inverse map measured at some of them;
+//   widenSource    where the stretch asks, copies of the old band widened by fast marching;
+//   growBand       the band switched on around the images;
+//   sample         every moving leaf's voxels sampled at their pre-images (5.3.3);
+//   fixSigns       the inactive signs re-derived in the leaves sampling rewrote;
+//   renormalize    the changed voxels given their distances again (fast marching);
+//   report         the boxes of what changed, for the mesh.
+// A Sculptor keeps one for all its segments, so the scratch the phases fill (the interface
+// list, each thread's images and mapped points, the staged values) keeps its storage from
+// one segment to the next instead of being allocated again each time.
+//
+// With `changed`, run() gives boxes (each within a voxel of one leaf) that hold every voxel
 // active before or after the segment whose value or active state changed: what a mesh kept
 // up to date reads again (SurfaceMesher::update). Inactive values (the signs the flood
 // re-derives, tiles) are left out: the band is valid before and after, and a valid band has
 // no inactive voxel within two voxels of its surface, as far as the mesh of a leaf reads.
+class SegmentAdvector {
+  public:
+    SegmentAdvector();
+    ~SegmentAdvector();
+    SegmentAdvector(SegmentAdvector&&) noexcept;
+    SegmentAdvector& operator=(SegmentAdvector&&) noexcept;
+
+    AdvectStats run(Grid& grid, const StepDeformation& segment, const AdvectOptions& options = {},
+                    std::vector<openvdb::CoordBBox>* changed = nullptr);
+
+    // How many times a scratch buffer had to grow so far: a long drag's segments, once the
+    // first few have sized them, should need no more.
+    std::size_t scratchGrowths() const;
+
+  private:
+    struct Work;
+    std::unique_ptr<Work> work_;
+};
+
+// One segment on its own (a SegmentAdvector made for it).
 AdvectStats advectSegment(Grid& grid, const StepDeformation& segment,
                           const AdvectOptions& options = {},
                           std::vector<openvdb::CoordBBox>* changed = nullptr);

@@ -1,4 +1,5 @@
 #include "levelset/dilate.h"
+#include "levelset/parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -120,19 +121,18 @@ template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box,
             leaves.push_back({c, Bits{}});
         }
     std::vector<Bits> out(leaves.size());
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, leaves.size(), 64), [&](const auto& range) {
-            for (std::size_t i = range.begin(); i != range.end(); ++i) {
-                openvdb::Coord c = leaves[i].at;
-                c[Axis] -= 1;
-                const int b = box.get(c);
-                c[Axis] += 2;
-                const int a = box.get(c);
-                out[i] = dilatedAlong<Axis>(leaves[i].bits,
-                                            b < 0 ? nullptr : &leaves[std::size_t(b)].bits,
-                                            a < 0 ? nullptr : &leaves[std::size_t(a)].bits, r);
-            }
-        });
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size(), 64), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            openvdb::Coord c = leaves[i].at;
+            c[Axis] -= 1;
+            const int b = box.get(c);
+            c[Axis] += 2;
+            const int a = box.get(c);
+            out[i] =
+                dilatedAlong<Axis>(leaves[i].bits, b < 0 ? nullptr : &leaves[std::size_t(b)].bits,
+                                   a < 0 ? nullptr : &leaves[std::size_t(a)].bits, r);
+        }
+    });
     for (std::size_t i = 0; i < leaves.size(); ++i)
         leaves[i].bits = out[i];
 }

@@ -1,4 +1,5 @@
 #include "levelset/fast_marching.h"
+#include "levelset/parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -66,7 +67,7 @@ class Domain {
             std::vector<char> listed(leaves_.size(), 0), kept(leaves_.size(), 0);
             for (const LeafVoxels& leaf : *near)
                 if (const int l = indexOf(leaf.origin); l >= 0) listed[std::size_t(l)] = 1;
-            tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+            parallelFor(std::size_t(0), leaves_.size(), [&](std::size_t l) {
                 for (int dx = -1; dx <= 1 && !kept[l]; ++dx)
                     for (int dy = -1; dy <= 1; ++dy)
                         for (int dz = -1; dz <= 1; ++dz)
@@ -85,7 +86,7 @@ class Domain {
         }
         neighbours_.resize(leaves_.size());
         // Each leaf's six neighbours (-1: none), in parallel.
-        tbb::parallel_for(std::size_t(0), leaves_.size(), [&](std::size_t l) {
+        parallelFor(std::size_t(0), leaves_.size(), [&](std::size_t l) {
             for (int a = 0; a < 3; ++a)
                 for (int d = 0; d < 2; ++d) {
                     openvdb::Coord p = at[l];
@@ -390,7 +391,7 @@ class Renormalizer {
                 if (l >= 0) leafwords::unite(within[std::size_t(l)], leaf.words);
             }
         }
-        tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
+        parallelFor(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             const Leaf& leaf = b_.leaf(l);
             // The leaves' values are read where they are: nothing writes them before the
             // write-back.
@@ -417,7 +418,7 @@ class Renormalizer {
         std::vector<Bits> free(b_.leafCount());
         for (std::size_t l = 0; l < b_.leafCount(); ++l)
             free[l] = ~fixed_[l];
-        tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
+        parallelFor(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             // (Domain::stepped moves a set within the leaf as well as across its faces.)
             const Bits next = nextTo(false, [&](auto a, int dir, Bits& out, Bits& valid) {
                 b_.stepped<decltype(a)::value>(free, l, dir, out, valid);
@@ -480,7 +481,7 @@ class Renormalizer {
   private:
     // Runs visit(leaf) for every leaf of the domain, in parallel.
     template <typename Visit> void forEachLeaf(const Visit& visit) const {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, b_.leafCount()), [&](const auto& r) {
+        parallelFor(tbb::blocked_range<std::size_t>(0, b_.leafCount()), [&](const auto& r) {
             for (std::size_t l = r.begin(); l != r.end(); ++l)
                 visit(l);
         });
@@ -754,7 +755,7 @@ class Renormalizer {
         for (int round = 0, again = 1; again && round < kMostRounds; ++round) {
             for (const auto& leavesOfClass : classes) {
                 pollInterrupt(interrupter_);
-                tbb::parallel_for(
+                parallelFor(
                     tbb::blocked_range<std::size_t>(0, leavesOfClass.size(), 4),
                     [&](const auto& r) {
                         Block& block = blocks.local();
@@ -952,7 +953,7 @@ class Renormalizer {
     std::size_t writeBack() {
         tbb::enumerable_thread_specific<std::size_t> solved(0);
         emptied_.assign(b_.leafCount(), 0);
-        tbb::parallel_for(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
+        parallelFor(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             // Only the free voxels, straight into the leaf's buffer and its mask a word at a
             // time (most of a domain is boundary; a setValueOn per voxel checked whether the
             // buffer was in memory every time). Four voxels at once: each distance capped at

@@ -20,6 +20,7 @@
 #include <tbb/parallel_for.h>
 
 #include "levelset/leaf_words.h"
+#include "levelset/parallel.h"
 #include "levelset/vdb.h"
 
 namespace sweepers {
@@ -174,7 +175,7 @@ inline std::size_t floodSignsIn(Grid::TreeType& tree, const std::vector<LeafNode
     // Leaves only read their own values, so they are filled in parallel; a node's tiles take
     // their signs from its children, so nodes are filled after them, bottom up.
     const float outside = std::abs(tree.background()), inside = -outside;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
         for (std::size_t l = r.begin(); l != r.end(); ++l)
             floodLeafSigns(*leaves[l], inside, outside);
     });
@@ -192,7 +193,7 @@ inline std::size_t floodSignsIn(Grid::TreeType& tree, const std::vector<LeafNode
             if (box.hasOverlap(lower->getNodeBoundingBox())) lowers.push_back(&*lower);
     }
     const auto fillAll = [&](const auto& nodes) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nodes.size(), 1), [&](const auto& r) {
+        parallelFor(tbb::blocked_range<std::size_t>(0, nodes.size(), 1), [&](const auto& r) {
             for (std::size_t i = r.begin(); i != r.end(); ++i)
                 fill(*nodes[i]);
         });

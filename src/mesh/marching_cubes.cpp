@@ -13,6 +13,7 @@
 #include "levelset/leaf_box.h"
 #include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
+#include "levelset/parallel.h"
 #include "levelset/stencils.h"
 #include "mesh/mc_table.h"
 
@@ -347,7 +348,7 @@ std::size_t SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvd
     std::vector<MeshChunk*> into(origins.size());
     std::vector<MeshChunk> fresh(origins.size());
     std::atomic<std::size_t> meshed{0};
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
+    parallelFor(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
         pollInterrupt(interrupter);
         std::size_t n = 0;
         for (std::size_t i = r.begin(); i != r.end(); ++i) {
@@ -492,7 +493,7 @@ TriangleMesh SurfaceMesher::weld() const {
         list.emplace_back(origin, &chunk);
     const std::size_t n = list.size();
     const auto forEachChunk = [&](const auto& body) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 64), [&](const auto& r) {
+        parallelFor(tbb::blocked_range<std::size_t>(0, n, 64), [&](const auto& r) {
             for (std::size_t c = r.begin(); c != r.end(); ++c)
                 body(c, *list[c].second);
         });

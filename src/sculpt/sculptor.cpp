@@ -1,5 +1,7 @@
 #include "sculpt/sculptor.h"
 
+#include "levelset/parallel.h"
+
 #include "core/stopwatch.h"
 
 namespace sweepers {
@@ -42,12 +44,13 @@ SegmentReport Sculptor::applySegment(const StepDeformation& deformation) {
     if (recording_) record_.capture(*grid_, changedRegion(*grid_, deformation));
     SegmentReport r;
     const auto t0 = Clock::now();
-    r.stats = advectSegment(*grid_, deformation, options_, meshing_ ? &changed_ : nullptr);
+    r.stats = advector_.run(*grid_, deformation, options_, meshing_ ? &changed_ : nullptr);
     r.seconds = secondsSince(t0);
     if (meshing_) {
-        const auto t1 = Clock::now();
+        const SerialClock clock;
         r.remeshedLeaves = mesher_.update(*grid_, changed_);
-        r.meshSeconds = secondsSince(t1);
+        r.meshSeconds = clock.wallSeconds();
+        r.meshSerialSeconds = clock.serialSeconds();
     }
     return r;
 }

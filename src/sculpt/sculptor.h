@@ -4,6 +4,7 @@
 // applySegment, so a recorded session replays to the same grid by construction.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <functional>
 #include <memory>
@@ -29,6 +30,14 @@ struct SegmentReport {
     // and clean-up around them (freeing the segment's masks and copies), which no stage of
     // AdvectStats times.
     double advectSeconds() const { return seconds - stats.renormalizeSeconds; }
+    double meshSerialSeconds = 0.0; // of the re-meshing, on one thread while others waited
+    // The segment's serial time (levelset/parallel.h): each stage's, the set-up and clean-up
+    // around them, which run on one thread, and the re-meshing's.
+    double serialSeconds() const {
+        const double stages = stats.growSeconds + stats.sampleSeconds + stats.renormalizeSeconds;
+        return stats.growSerialSeconds + stats.sampleSerialSeconds +
+               stats.renormalizeSerialSeconds + std::max(0.0, seconds - stages) + meshSerialSeconds;
+    }
     std::size_t remeshedLeaves = 0;
     double meshVolume = 0.0; // enclosed volume of the mesh after the segment (applyStrokes,
                              // when meshing: it sums the whole mesh)
@@ -59,6 +68,7 @@ class Sculptor {
     bool meshing() const { return meshing_; }
     SurfaceMesher& mesher() { return mesher_; }
     const SurfaceMesher& mesher() const { return mesher_; }
+    const SegmentAdvector& advector() const { return advector_; }
 
     // Undo: while recording, every block a segment may change is saved once, before it
     // changes. stopRecording hands the saved blocks over.
@@ -79,6 +89,7 @@ class Sculptor {
   private:
     GridPtr grid_;
     AdvectOptions options_;
+    SegmentAdvector advector_; // one for every segment: its scratch is kept between them
     SurfaceMesher mesher_;
     bool meshing_ = false, recording_ = false;
     LeafSnapshot record_;

@@ -56,6 +56,7 @@ GridPtr timedOnCopies(benchmark::State& state, const Grid& start,
 
 // Registration, one function per group (called by main in this order).
 void registerDragBenchmarks();
+void registerThreadBenchmarks();
 void registerScaleBenchmarks();
 void registerAdvectBenchmarks();
 void registerRenormalizeBenchmarks();

@@ -191,6 +191,7 @@ std::string referenceOf(const std::string& group) {
     if (group == "advect" || group == "enright") return "openvdb_LevelSetAdvection";
     if (group == "renorm") return "openvdb_sdfToSdf";
     if (group == "mesh") return "openvdb_volumeToMesh";
+    if (group == "threads") return "threads_1";
     return "";
 }
 
@@ -256,6 +257,7 @@ int main(int argc, char** argv) {
 
     registerDragBenchmarks();
     registerScaleBenchmarks();
+    registerThreadBenchmarks();
     registerAdvectBenchmarks();
     registerRenormalizeBenchmarks();
     registerMeshBenchmarks();
@@ -313,7 +315,8 @@ int main(int argc, char** argv) {
         }
         csv << row << "time_ms," << r.GetAdjustedRealTime() << "\n";
         if (const auto s = speedUp.find(r.benchmark_name()); s != speedUp.end())
-            csv << row << "speedup_vs_openvdb," << s->second << "\n";
+            csv << row << (n.group == "threads" ? "speedup_vs_one_thread," : "speedup_vs_openvdb,")
+                << s->second << "\n";
         for (const auto& [key, counter] : r.counters)
             csv << row << key << "," << counter.value << "\n";
     }

@@ -9,6 +9,9 @@
 // brush touches, not what the model holds.
 #include <algorithm>
 #include <cstdio>
+#include <thread>
+
+#include <tbb/global_control.h>
 
 #include "bench.h"
 #include "core/memory.h"
@@ -22,20 +25,28 @@ namespace {
 
 // Per-segment figures of a run: p50 and p95 of the whole segment and p50 of each stage.
 void addSegmentCounters(benchmark::State& state, const std::vector<SegmentReport>& reports) {
-    std::vector<double> total, advect, renorm, mesh;
+    std::vector<double> total, advect, renorm, mesh, serial;
+    double allTime = 0.0, allSerial = 0.0;
     for (const SegmentReport& r : reports) {
         total.push_back(1e3 * (r.seconds + r.meshSeconds));
         advect.push_back(1e3 * r.advectSeconds());
         renorm.push_back(1e3 * r.stats.renormalizeSeconds);
         mesh.push_back(1e3 * r.meshSeconds);
+        serial.push_back(1e3 * r.serialSeconds());
+        allTime += r.seconds + r.meshSeconds;
+        allSerial += r.serialSeconds();
     }
     for (const auto& [name, v] : {std::pair{"segment", &total},
                                   {"advect", &advect},
                                   {"renorm", &renorm},
-                                  {"mesh", &mesh}}) {
+                                  {"mesh", &mesh},
+                                  {"serial", &serial}}) {
         state.counters[std::string(name) + "_p50_ms"] = percentile(*v, 0.5);
         state.counters[std::string(name) + "_p95_ms"] = percentile(*v, 0.95);
     }
+    // The share of the segments' time during which one thread worked and the others waited
+    // (levelset/parallel.h): at one thread, Amdahl's bound on what more cores can give.
+    state.counters["serial_fraction"] = allTime > 0.0 ? allSerial / allTime : 0.0;
     state.counters["segments"] = double(reports.size());
 }
 
@@ -84,6 +95,35 @@ void registerScaleBenchmarks() {
             },
             1);
     }
+}
+
+void registerThreadBenchmarks() {
+    // The drag at 1/256 and 1/512 at 1, 2, 4 and 8 threads and at every core the machine has:
+    // the speed-up over one thread (printed against threads_1) and the serial fraction.
+    std::vector<int> counts{1, 2, 4, 8};
+    const int all = int(std::max(1u, std::thread::hardware_concurrency()));
+    if (std::find(counts.begin(), counts.end(), all) == counts.end()) counts.push_back(all);
+    for (const int div : {256, 512})
+        for (const int threads : counts)
+            add(
+                "threads/drag100_h" + std::to_string(div) + "/threads_" + std::to_string(threads),
+                [div, threads](benchmark::State& state) {
+                    const tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                                                    std::size_t(threads));
+                    const StrokeScript script =
+                        readStrokeScript(std::string(SWEEPERS_DATA_DIR) + "/drag.json");
+                    std::vector<SegmentReport> reports;
+                    for (auto _ : state) {
+                        state.PauseTiming();
+                        Sculptor sculptor(makeStartGrid(script, SWEEPERS_DATA_DIR, 1.0 / div));
+                        sculptor.startMeshing();
+                        state.ResumeTiming();
+                        reports = applyStrokes(sculptor, script.strokes);
+                    }
+                    addSegmentCounters(state, reports);
+                    state.counters["threads"] = threads;
+                },
+                1);
 }
 
 void registerDragBenchmarks() {

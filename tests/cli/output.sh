@@ -104,6 +104,25 @@ assert all(os.path.exists(f) for f in j["files"]) and len(j["files"]) == 3, j["f
 PY
 echo "--json: apply, info, check, study and animate print one object with their keys"
 
+# --- --stats: a row per segment, with its serial time (what more cores cannot shorten) ----
+"$cli" --threads 1 apply "$data/drag.json" -o "$tmp/s.vdb" --voxel-size 0.05 --stats -q \
+  2>"$tmp/stats"
+"$py" - "$tmp/stats" <<'PY'
+import sys
+lines = [l.split() for l in open(sys.argv[1])]
+head = next(l for l in lines if l and l[0] == "stroke")
+rows = [dict(zip(head, l)) for l in lines if len(l) == len(head) and l[0].isdigit()]
+assert len(rows) == 100, len(rows)
+for r in rows:
+    stages = sum(float(r[k]) for k in ("grow_ms", "sample_ms", "renorm_ms", "mesh_ms"))
+    serial = float(r["serial_ms"])
+    # At one thread the serial time is the segment's time outside its parallel loops (and
+    # their overhead): never negative, never more than the segment (a stage's figures are
+    # rounded to 0.1 ms; the set-up around the stages is serial too).
+    assert 0.0 <= serial <= stages + 1.0, r
+print("--stats: serial_ms in each of the %d rows" % len(rows))
+PY
+
 # --- exit codes ---------------------------------------------------------------------------
 code() { # code EXPECTED ARGS... : the command exits EXPECTED
   local expected=$1 rc=0

@@ -564,3 +564,20 @@ TEST(Advect, ADragMeasuresNoStretchAndSculptsTheSame) {
     }
     EXPECT_EQ(sweepers::test::differingVoxels(*bounded, *measured), 0u);
 }
+
+// A Sculptor's advector keeps its scratch between segments: once the first segments of a
+// drag have sized the buffers, the rest of a long drag of like segments grows none of them.
+TEST(Advect, TheAdvectorReusesItsBuffersFromSegmentToSegment) {
+    const StrokeScript script = readStrokeScript(std::string(SWEEPERS_DATA_DIR) + "/drag.json");
+    Sculptor sculptor(makeSphere({0, 0, 0}, 1.0, 1.0 / 64, 3.0));
+    const std::size_t warmUp = 10;
+    std::size_t done = 0, afterWarmUp = 0;
+    applyStrokes(sculptor, script.strokes, [&](std::size_t d, std::size_t) {
+        done = d;
+        if (d == warmUp) afterWarmUp = sculptor.advector().scratchGrowths();
+    });
+    ASSERT_GE(done, 5 * warmUp); // a long drag
+    EXPECT_GT(afterWarmUp, 0u);  // the first segments sized the buffers
+    EXPECT_EQ(sculptor.advector().scratchGrowths(), afterWarmUp)
+        << "a buffer grew after the first " << warmUp << " segments";
+}
