@@ -356,6 +356,36 @@ int runApply(const ApplyArgs& a) {
                 1e3 * r.stats.renormalizeSeconds, 1e3 * r.meshSeconds, 1e3 * r.serialSeconds(),
                 r.remeshedLeaves, r.meshVolume, r.stats.voxelsVisited, r.stats.leavesCopied,
                 r.stats.leavesFlooded);
+        // Where the time goes, phase by phase (mean over the segments): all of it, and the
+        // part during which one thread worked while the others waited.
+        if (!reports.empty()) {
+            std::string line = "per segment, mean ms (serial):";
+            const double n = double(reports.size());
+            for (std::size_t k = 0; k < kAdvectPhases.size(); ++k) {
+                double wall = 0.0, serial = 0.0;
+                for (const auto& r : reports) {
+                    wall += r.stats.phases[k].seconds;
+                    serial += r.stats.phases[k].serialSeconds;
+                }
+                char part[96];
+                std::snprintf(part, sizeof part, " %s %.2f (%.2f)", kAdvectPhases[k],
+                              1e3 * wall / n, 1e3 * serial / n);
+                line += part;
+            }
+            double wall = 0.0, serial = 0.0, all = 0.0, allSerial = 0.0;
+            for (const auto& r : reports) {
+                wall += r.meshSeconds;
+                serial += r.meshSerialSeconds;
+                all += r.seconds + r.meshSeconds;
+                allSerial += r.serialSeconds();
+            }
+            char part[160];
+            std::snprintf(part, sizeof part,
+                          " mesh %.2f (%.2f); segment %.2f (%.2f), serial fraction %.3f",
+                          1e3 * wall / n, 1e3 * serial / n, 1e3 * all / n, 1e3 * allSerial / n,
+                          all > 0.0 ? allSerial / all : 0.0);
+            std::fprintf(stderr, "%s%s\n", line.c_str(), part);
+        }
     }
     double adv = 0, ren = 0, grow = 0;
     for (const auto& r : reports) {

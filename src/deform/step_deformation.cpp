@@ -17,8 +17,8 @@ Eigen::Vector3d StepDeformation::inverseMap(const Eigen::Vector3d& p) const {
     return q;
 }
 
-void StepDeformation::inverseMaps(const Eigen::Vector3d* p, std::size_t n,
-                                  Eigen::Vector3d* out) const {
+void StepDeformation::inverseMaps(const Eigen::Vector3d* p, std::size_t n, Eigen::Vector3d* out,
+                                  MapScratch&) const {
     for (std::size_t i = 0; i < n; ++i)
         out[i] = inverseMap(p[i]);
 }
@@ -32,7 +32,7 @@ ForwardResult StepDeformation::forwardStep(int k, const Eigen::Vector3d& q,
 }
 
 void StepDeformation::forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, double tolerance,
-                                   Eigen::Vector3d* out) const {
+                                   Eigen::Vector3d* out, MapScratch&) const {
     for (std::size_t i = 0; i < n; ++i)
         out[i] = forwardStep(k, q[i], tolerance).p;
 }

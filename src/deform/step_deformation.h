@@ -7,11 +7,23 @@
 
 #include <limits>
 #include <optional>
+#include <vector>
 
 #include "core/box.h"
 #include "core/motion_log.h"
 
 namespace sweepers {
+
+// What the batched maps use while they run (inverseMaps, forwardSteps): the caller keeps
+// one per thread, so that its storage serves call after call.
+struct MapScratch {
+    std::vector<std::size_t> which; // the points still moving, or still iterating
+    std::vector<double> tolerance;  // forwardSteps: each point's stopping distance
+    // The points of `which` in a sub-step's box, and a tool's influence there.
+    std::vector<std::size_t> index;
+    std::vector<Eigen::Vector3d> points;
+    std::vector<double> phi;
+};
 
 struct ForwardResult {
     Eigen::Vector3d p;
@@ -42,7 +54,12 @@ class StepDeformation {
     Eigen::Vector3d inverseMap(const Eigen::Vector3d& p) const;
     // The whole inverse at the n points p, into out (the same values as inverseMap, to the
     // bit): sampling maps a leaf's voxels in one call.
-    virtual void inverseMaps(const Eigen::Vector3d* p, std::size_t n, Eigen::Vector3d* out) const;
+    virtual void inverseMaps(const Eigen::Vector3d* p, std::size_t n, Eigen::Vector3d* out,
+                             MapScratch& scratch) const;
+    void inverseMaps(const Eigen::Vector3d* p, std::size_t n, Eigen::Vector3d* out) const {
+        MapScratch scratch;
+        inverseMaps(p, n, out, scratch);
+    }
     // Forward sub-step k: the p with inverseStep(k, p) = q, to `tolerance` (relative to
     // 1 + |q|; forwardTolerance() when 0). inverseStep(k, p) = exp(-L(p)) p = q holds
     // exactly when p = exp(L(p)) q, which is iterated on p: a contraction wherever the
@@ -52,7 +69,12 @@ class StepDeformation {
     // forwardStep(k, q[i], tolerance).p for the n points q, into out (the same values, to
     // the bit): the band's growth maps a run of interface voxels in one call.
     virtual void forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, double tolerance,
-                              Eigen::Vector3d* out) const;
+                              Eigen::Vector3d* out, MapScratch& scratch) const;
+    void forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, double tolerance,
+                      Eigen::Vector3d* out) const {
+        MapScratch scratch;
+        forwardSteps(k, q, n, tolerance, out, scratch);
+    }
     // Whole forward map: forward sub-steps 0 up to s-1.
     ForwardResult forwardMap(const Eigen::Vector3d& p) const;
 

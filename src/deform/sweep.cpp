@@ -156,28 +156,27 @@ Eigen::Vector3d SweepSegment::inverseStep(int k, const Eigen::Vector3d& p) const
     return oneToolStep(-oneToolInfluence(k, p), p);
 }
 
-void SweepSegment::inverseMaps(const Eigen::Vector3d* p, std::size_t n,
-                               Eigen::Vector3d* out) const {
-    if (tools_.size() != 1) return StepDeformation::inverseMaps(p, n, out);
+void SweepSegment::inverseMaps(const Eigen::Vector3d* p, std::size_t n, Eigen::Vector3d* out,
+                               MapScratch& scratch) const {
+    if (tools_.size() != 1) return StepDeformation::inverseMaps(p, n, out, scratch);
     // inverseMap a sub-step at a time over all the points: those in the sub-step's box are
     // gathered and their influences found in one call (a call per point went through
     // inverseStep, influence and the shape's distance, two of them virtual).
-    thread_local std::vector<std::size_t> moved;
-    thread_local InBox box;
+    std::vector<std::size_t>& moved = scratch.which;
     moved.clear();
     for (std::size_t i = 0; i < n; ++i) {
         out[i] = p[i];
         if (!stillAt(p[i])) moved.push_back(i);
     }
     for (int k = steps_ - 1; k >= 0; --k) {
-        influencesInBox(k, moved, out, box);
-        for (std::size_t j = 0; j < box.index.size(); ++j)
-            out[box.index[j]] = oneToolStep(-box.phi[j], box.points[j]);
+        influencesInBox(k, moved, out, scratch);
+        for (std::size_t j = 0; j < scratch.index.size(); ++j)
+            out[scratch.index[j]] = oneToolStep(-scratch.phi[j], scratch.points[j]);
     }
 }
 
 void SweepSegment::influencesInBox(int k, const std::vector<std::size_t>& which,
-                                   const Eigen::Vector3d* at, InBox& into) const {
+                                   const Eigen::Vector3d* at, MapScratch& into) const {
     into.index.clear();
     into.points.clear();
     for (const std::size_t i : which)
@@ -199,14 +198,13 @@ ForwardResult SweepSegment::forwardStep(int k, const Eigen::Vector3d& q, double 
 }
 
 void SweepSegment::forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, double tolerance,
-                                Eigen::Vector3d* out) const {
-    if (tools_.size() != 1) return StepDeformation::forwardSteps(k, q, n, tolerance, out);
+                                Eigen::Vector3d* out, MapScratch& scratch) const {
+    if (tools_.size() != 1) return StepDeformation::forwardSteps(k, q, n, tolerance, out, scratch);
     // forwardStep's iteration run on all the points at once, each until it converges (to the
     // bit what it gives one point at a time): the influences of the points still iterating
     // in the sub-step's box are found in one call per iteration.
-    thread_local std::vector<std::size_t> iterating;
-    thread_local std::vector<double> tol;
-    thread_local InBox box;
+    std::vector<std::size_t>& iterating = scratch.which;
+    std::vector<double>& tol = scratch.tolerance;
     iterating.resize(n);
     tol.resize(n);
     for (std::size_t i = 0; i < n; ++i) {
@@ -215,12 +213,12 @@ void SweepSegment::forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, 
         tol[i] = forwardToleranceAt(q[i], tolerance);
     }
     for (int it = 1; it <= forwardMaxIterations_ && !iterating.empty(); ++it) {
-        influencesInBox(k, iterating, out, box);
+        influencesInBox(k, iterating, out, scratch);
         // Each point's next iterate: q where its influence is 0 (outside the box too).
         std::size_t j = 0, kept = 0;
         for (const std::size_t i : iterating) {
             double w = 0.0;
-            if (j < box.index.size() && box.index[j] == i) w = box.phi[j++];
+            if (j < scratch.index.size() && scratch.index[j] == i) w = scratch.phi[j++];
             const Eigen::Vector3d next = oneToolStep(w, q[i]);
             const double change = (next - out[i]).norm();
             out[i] = next;

@@ -73,9 +73,12 @@ class SweepSegment : public StepDeformation {
     // For one tool, the blend is its influence times its log (3.17 with c phi = phi): the
     // sub-steps apply that directly. Several tools take the blend of stepLog.
     Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const override;
-    void inverseMaps(const Eigen::Vector3d* p, std::size_t n, Eigen::Vector3d* out) const override;
+    using StepDeformation::forwardSteps;
+    using StepDeformation::inverseMaps;
+    void inverseMaps(const Eigen::Vector3d* p, std::size_t n, Eigen::Vector3d* out,
+                     MapScratch& scratch) const override;
     void forwardSteps(int k, const Eigen::Vector3d* q, std::size_t n, double tolerance,
-                      Eigen::Vector3d* out) const override;
+                      Eigen::Vector3d* out, MapScratch& scratch) const override;
     ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
                               double tolerance = 0.0) const override;
 
@@ -98,14 +101,10 @@ class SweepSegment : public StepDeformation {
     }
 
     // The points at[i], i in `which` (in order), that lie in sub-step k's box, and the one
-    // tool's influence there (influence, to the bit): what the batched maps gather.
-    struct InBox {
-        std::vector<std::size_t> index;
-        std::vector<Eigen::Vector3d> points;
-        std::vector<double> phi;
-    };
+    // tool's influence there (influence, to the bit), into the scratch's index, points and
+    // phi: what the batched maps gather.
     void influencesInBox(int k, const std::vector<std::size_t>& which, const Eigen::Vector3d* at,
-                         InBox& into) const;
+                         MapScratch& into) const;
 
     struct ToolPlan {
         MotionLog log;                                   // log M_j for the whole segment

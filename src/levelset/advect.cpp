@@ -267,8 +267,8 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 }
 
 // Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
-// the pre-image of x (`map(x, n, y)` maps a leaf's n voxels x at once, into y), and lists in
-// `changed` the voxels whose value changed, a leaf at a time (a leaf resampled again is listed
+// the pre-image of x (`map(x, n, y, scratch)` maps a leaf's n voxels x at once, into y), and lists
+// in `changed` the voxels whose value changed, a leaf at a time (a leaf resampled again is listed
 // again). When the source holds the grid's own values
 // (`sourceIsGrid`: no widened band), a voxel that the map leaves in place keeps its value
 // without interpolating: a sample at a voxel centre returns it exactly. With `staged`, the
@@ -282,6 +282,7 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 // Per thread, what sampling a leaf uses: the block of source values around it, and its
 // voxels to sample with their places and pre-images.
 struct ResampleScratch {
+    MapScratch maps;
     SourceBlock block;
     std::array<std::uint16_t, LeafNode::SIZE> at;
     std::array<Eigen::Vector3d, LeafNode::SIZE> x, y;
@@ -329,7 +330,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                 const openvdb::Coord ijk = LeafNode::offsetToLocalCoord(s.at[std::size_t(i)]);
                 s.x[std::size_t(i)] = toEigen(place.toWorld((leaf.origin() + ijk).asVec3d()));
             }
-            map(s.x.data(), std::size_t(listed), s.y.data());
+            map(s.x.data(), std::size_t(listed), s.y.data(), s.maps);
             bool filled = false; // the block is filled for the leaf's first sample
             const float* values = leaf.buffer().data();
             float* const out = staged ? &staged->values[l * LeafNode::SIZE] : leaf.buffer().data();
@@ -514,11 +515,22 @@ void makeLeavesWithin(Grid& grid, const VoxelList& mask, int beyond,
             }
         }
     });
-    // (A leaf two mask entries reach is listed twice: touching it again finds it.)
-    auto acc = grid.getAccessor();
+    // A leaf two mask entries reach is listed twice: each is made once. The new leaves take
+    // the value and state of the tile they replace; they are made in parallel, and only put
+    // into the tree on this thread.
+    std::vector<openvdb::Coord> origins;
     for (const auto& list : missing)
-        for (const openvdb::Coord& o : list)
-            acc.touchLeaf(o);
+        origins.insert(origins.end(), list.begin(), list.end());
+    std::sort(origins.begin(), origins.end());
+    origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
+    std::vector<LeafNode*> made(origins.size());
+    parallelFor(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
+        const auto acc = grid.getConstAccessor();
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+            made[i] = new LeafNode(origins[i], acc.getValue(origins[i]), acc.isValueOn(origins[i]));
+    });
+    for (LeafNode* leaf : made)
+        grid.tree().addLeaf(leaf);
 }
 
 // How many voxels (face steps) the band of each of `leaves` is to be widened by. A stretch s
@@ -579,16 +591,22 @@ openvdb::CoordBBox indexBox(const Grid& grid, const Box& world, int pad) {
 // A segment's state between its phases, and the scratch that outlives it.
 struct SegmentAdvector::Work {
     // --- scratch kept from segment to segment ---------------------------------------------
-    std::atomic<std::size_t> growths{0}; // times one of the buffers below had to grow
+    // Times one of the buffers below had to grow. (A thread's own buffers are not counted: a
+    // thread that first takes part in a later segment makes them then, whatever the stroke.
+    // Its mapped points come in batches of a fixed size, and its list of images keeps room
+    // for twice what it held.)
+    std::atomic<std::size_t> growths{0};
     std::vector<LeafNode::NodeMaskType> crossing;
     std::vector<std::size_t> first;
     std::vector<char> scanned;
+    std::vector<openvdb::Index64> onVoxels;
     std::vector<openvdb::Coord> interface;
     std::vector<double> stretchAt;
     // Per thread: the images it marked, and the points it maps a sub-step at a time.
     struct Mapping {
         VoxelList marked;
         std::vector<Eigen::Vector3d> mapped, next;
+        MapScratch maps;
     };
     tbb::enumerable_thread_specific<Mapping> mapping;
     ResampleScratches resampling;
@@ -681,6 +699,7 @@ void SegmentAdvector::Work::findInterface() {
     fit(crossing, leaves.size());
     fit(first, leaves.size() + 1);
     fit(scanned, leaves.size());
+    fit(onVoxels, leaves.size());
     first[0] = 0;
     parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
         const auto acc = grid->getConstAccessor();
@@ -691,6 +710,7 @@ void SegmentAdvector::Work::findInterface() {
             first[l + 1] = 0;
             if (still(leaf)) continue;
             scanned[l] = 1;
+            onVoxels[l] = leaf.onVoxelCount();
             // The active voxels next to the crossing, a word of the masks at a time (a
             // leaf's 300 or so active voxels hold some 40 of them).
             crossing[l] = crossingVoxels(leaf, acc);
@@ -706,7 +726,7 @@ void SegmentAdvector::Work::findInterface() {
         first[l + 1] += first[l];
         if (!scanned[l]) continue;
         ++stats.leavesVisited;
-        stats.voxelsVisited += leaves[l]->onVoxelCount();
+        stats.voxelsVisited += onVoxels[l];
     }
     fit(interface, first[leaves.size()]);
     parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
@@ -759,11 +779,9 @@ void SegmentAdvector::Work::mapImages() {
         // batch of fixed size, so that the buffers need no more room however the loop is
         // split among the threads).
         std::vector<Eigen::Vector3d>&mapped = m.mapped, &next = m.next;
-        const std::size_t before = marked.capacity();
         if (mapped.capacity() < kMapBatch) {
             mapped.reserve(kMapBatch);
             next.reserve(kMapBatch);
-            ++growths;
         }
         for (std::size_t b = r.begin(); b < r.end(); b += kMapBatch) {
             const std::size_t e = std::min(b + kMapBatch, r.end());
@@ -772,7 +790,8 @@ void SegmentAdvector::Work::mapImages() {
             for (std::size_t i = b; i != e; ++i)
                 mapped[i - b] = toEigen(place.toWorld(interface[i].asVec3d()));
             for (int k = 0; k < seg->steps(); ++k) {
-                seg->forwardSteps(k, mapped.data(), mapped.size(), forwardTolerance, next.data());
+                seg->forwardSteps(k, mapped.data(), mapped.size(), forwardTolerance, next.data(),
+                                  m.maps);
                 mapped.swap(next);
                 // Intermediate surfaces only need a band when they are stored.
                 if (options->resampleEachSubStep || k + 1 == seg->steps())
@@ -797,7 +816,6 @@ void SegmentAdvector::Work::mapImages() {
                 stretchAt[i / kStretchSampling] = std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
             }
         }
-        if (marked.capacity() > before) ++growths;
     });
     // Each thread's list keeps room for twice what it marked this time.
     for (Mapping& m : mapping)
@@ -862,14 +880,20 @@ void SegmentAdvector::Work::widenSource() {
 // parallel (the list holds each leaf once, so no two tasks write one leaf).
 VoxelList SegmentAdvector::Work::switchOn(const VoxelList& on) {
     std::vector<const LeafVoxels*> from;
-    std::vector<LeafNode*> to;
+    for (const LeafVoxels& leaf : on)
+        if (leafwords::any(leaf.words)) from.push_back(&leaf);
+    // Most of the leaves are there already: they are found in parallel (reading the tree),
+    // and only the missing ones are made, on this thread (the tree changes).
+    std::vector<LeafNode*> to(from.size());
+    parallelFor(tbb::blocked_range<std::size_t>(0, from.size(), 64), [&](const auto& r) {
+        const auto acc = grid->getConstAccessor();
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+            to[i] = const_cast<LeafNode*>(acc.probeConstLeaf(from[i]->origin));
+    });
     {
         auto into = grid->getAccessor();
-        for (const LeafVoxels& leaf : on) {
-            if (!leafwords::any(leaf.words)) continue;
-            from.push_back(&leaf);
-            to.push_back(into.touchLeaf(leaf.origin));
-        }
+        for (std::size_t i = 0; i < from.size(); ++i)
+            if (!to[i]) to[i] = into.touchLeaf(from[i]->origin);
     }
     std::vector<leafwords::Words> newlyOn(from.size());
     parallelFor(tbb::blocked_range<std::size_t>(0, from.size()), [&](const auto& r) {
@@ -958,7 +982,7 @@ void SegmentAdvector::Work::sample() {
             const auto from = sourceOfSubStep(k);
             stats.sampledVoxels += resample(
                 *grid, moving, *from, !widened || k > 0, region,
-                [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y) {
+                [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y, MapScratch&) {
                     for (std::size_t i = 0; i < n; ++i)
                         y[i] = seg->inverseStep(k, x[i]);
                 },
@@ -967,9 +991,8 @@ void SegmentAdvector::Work::sample() {
         }
         return;
     }
-    const auto map = [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y) {
-        seg->inverseMaps(x, n, y);
-    };
+    const auto map = [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y,
+                         MapScratch& scratch) { seg->inverseMaps(x, n, y, scratch); };
     // Sampling reads the grid itself and writes beside it (staged), or, from a widened band,
     // reads the copies that hold it and writes into the grid.
     const auto from =
@@ -1083,35 +1106,42 @@ AdvectStats SegmentAdvector::run(Grid& grid, const StepDeformation& segment,
                                  std::vector<openvdb::CoordBBox>* changed) {
     Work& w = *work_;
     w.begin(grid, segment, options);
-    {
+    AdvectStats& stats = w.stats;
+    // Each phase under a clock of its own: its wall time and its serial time.
+    const auto phase = [&](std::size_t k, auto&& body) {
         const SerialClock clock;
-        w.findInterface();
-        w.mapImages();
-        w.widenSource();
-        w.growBand();
-        w.stats.growSeconds = clock.wallSeconds();
-        w.stats.growSerialSeconds = clock.serialSeconds();
-    }
-    {
-        const SerialClock clock;
-        w.sample();
-        w.fixSigns();
-        w.stats.sampleSeconds = clock.wallSeconds();
-        w.stats.sampleSerialSeconds = clock.serialSeconds();
-    }
-    {
-        const SerialClock clock;
-        w.renormalizeChanged();
-        w.stats.renormalizeSeconds = clock.wallSeconds();
-        w.stats.renormalizeSerialSeconds = clock.serialSeconds();
-    }
-    w.stats.touched = w.touched;
-    w.report(changed);
-    // What the segment holds of the grid goes: the next one starts from the grid alone.
-    w.widened.reset();
-    w.sampled.clear();
-    w.moving.clear();
-    return w.stats;
+        body();
+        stats.phases[k] = {clock.wallSeconds(), clock.serialSeconds()};
+    };
+    phase(0, [&] { w.findInterface(); });
+    phase(1, [&] { w.mapImages(); });
+    phase(2, [&] { w.widenSource(); });
+    phase(3, [&] { w.growBand(); });
+    phase(4, [&] { w.sample(); });
+    phase(5, [&] { w.fixSigns(); });
+    phase(6, [&] { w.renormalizeChanged(); });
+    const auto sum = [&](std::size_t a, std::size_t b, double AdvectStats::PhaseTime::*part) {
+        double t = 0.0;
+        for (std::size_t k = a; k < b; ++k)
+            t += stats.phases[k].*part;
+        return t;
+    };
+    using P = AdvectStats::PhaseTime;
+    stats.growSeconds = sum(0, 4, &P::seconds);
+    stats.growSerialSeconds = sum(0, 4, &P::serialSeconds);
+    stats.sampleSeconds = sum(4, 6, &P::seconds);
+    stats.sampleSerialSeconds = sum(4, 6, &P::serialSeconds);
+    stats.touched = w.touched;
+    phase(7, [&] {
+        w.report(changed);
+        // What the segment holds of the grid goes: the next one starts from the grid alone.
+        w.widened.reset();
+        w.sampled.clear();
+        w.moving.clear();
+    });
+    stats.renormalizeSeconds = stats.phases[6].seconds;
+    stats.renormalizeSerialSeconds = stats.phases[6].serialSeconds;
+    return stats;
 }
 
 AdvectStats advectSegment(Grid& grid, const StepDeformation& segment, const AdvectOptions& options,

@@ -18,6 +18,7 @@
 // flood fill and the box is renormalized.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -38,6 +39,11 @@ struct AdvectOptions {
     Interrupter* interrupter = nullptr; // polled per leaf range; throws Cancelled
 };
 
+// The phases of a segment's step, as AdvectStats::phases lists them.
+inline constexpr std::array<const char*, 8> kAdvectPhases{
+    "find_interface", "map_images", "widen_source", "grow_band",
+    "sample",         "fix_signs",  "renormalize",  "report"};
+
 struct AdvectStats {
     int subSteps = 0;
     std::size_t interfaceVoxels = 0; // forward-mapped to grow the band
@@ -57,6 +63,12 @@ struct AdvectStats {
     // Of each, the time one thread worked while the others waited (levelset/parallel.h):
     // what more cores cannot shorten.
     double growSerialSeconds = 0.0, sampleSerialSeconds = 0.0, renormalizeSerialSeconds = 0.0;
+    // The same for each phase of SegmentAdvector, in the order of kAdvectPhases (the first
+    // four make band growth, the next two sampling, the last two renormalization).
+    struct PhaseTime {
+        double seconds = 0.0, serialSeconds = 0.0;
+    };
+    std::array<PhaseTime, 8> phases{};
     openvdb::CoordBBox touched; // index box whose values may have changed
 };
 
@@ -89,8 +101,9 @@ class SegmentAdvector {
     AdvectStats run(Grid& grid, const StepDeformation& segment, const AdvectOptions& options = {},
                     std::vector<openvdb::CoordBBox>* changed = nullptr);
 
-    // How many times a scratch buffer had to grow so far: a long drag's segments, once the
-    // first few have sized them, should need no more.
+    // How many times one of its buffers (the interface list and its per-leaf counts, the
+    // stretch samples, the images, the staged values) had to grow so far: a long drag's
+    // segments, once the first few have sized them, should need no more.
     std::size_t scratchGrowths() const;
 
   private:

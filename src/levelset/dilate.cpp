@@ -111,12 +111,28 @@ template <int Axis> bool spills(const Bits& b, int dir, int r) {
 // neighbours it reaches into. Each leaf's result is read from itself and its two neighbours
 // along the axis, so the leaves are done in parallel.
 template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box, int r) {
+    // Which leaves reach into a neighbour the list lacks, found in parallel (the box is only
+    // read); the few new leaves are then added on this thread, in the list's order.
     const std::size_t count = leaves.size();
+    std::vector<std::uint8_t> reaches(count);
+    parallelFor(tbb::blocked_range<std::size_t>(0, count, 256), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            std::uint8_t sides = 0;
+            for (const int dir : {-1, 1}) {
+                openvdb::Coord c = leaves[i].at;
+                c[Axis] += dir;
+                if (box.get(c) < 0 && spills<Axis>(leaves[i].bits, dir, r))
+                    sides |= dir < 0 ? 1 : 2;
+            }
+            reaches[i] = sides;
+        }
+    });
     for (std::size_t i = 0; i < count; ++i)
         for (const int dir : {-1, 1}) {
+            if (!(reaches[i] & (dir < 0 ? 1 : 2))) continue;
             openvdb::Coord c = leaves[i].at;
             c[Axis] += dir;
-            if (box.at(c) >= 0 || !spills<Axis>(leaves[i].bits, dir, r)) continue;
+            if (box.at(c) >= 0) continue; // added already, from its other side
             box.at(c) = int(leaves.size());
             leaves.push_back({c, Bits{}});
         }
@@ -133,8 +149,10 @@ template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box,
                                    a < 0 ? nullptr : &leaves[std::size_t(a)].bits, r);
         }
     });
-    for (std::size_t i = 0; i < leaves.size(); ++i)
-        leaves[i].bits = out[i];
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size(), 256), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i)
+            leaves[i].bits = out[i];
+    });
 }
 
 // Dilates the leaves of [begin, end) by the cube of half-side `radius`, onto the end of
@@ -185,10 +203,17 @@ bool dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
         dilateList<1>(leaves, box, r);
         dilateList<0>(leaves, box, r);
     }
-    for (const MaskLeaf& leaf : leaves)
-        // (Multiplied, not shifted: a left shift of a negative coordinate is undefined.)
-        out.push_back({openvdb::Coord(leaf.at.x() * kDim, leaf.at.y() * kDim, leaf.at.z() * kDim),
-                       leaf.bits});
+    const std::size_t first = out.size();
+    out.resize(first + leaves.size());
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size(), 256), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i) {
+            const MaskLeaf& leaf = leaves[i];
+            // (Multiplied, not shifted: a left shift of a negative coordinate is undefined.)
+            out[first + i] = {
+                openvdb::Coord(leaf.at.x() * kDim, leaf.at.y() * kDim, leaf.at.z() * kDim),
+                leaf.bits};
+        }
+    });
     return false;
 }
 
@@ -198,8 +223,10 @@ VoxelList dilatedByCube(const VoxelList& from, int radius) {
     if (radius < 0) throw std::invalid_argument("dilatedByCube: a negative radius");
     if (radius == 0) return eachLeafOnce(from);
     std::vector<MaskLeaf> leaves(from.size());
-    for (std::size_t i = 0; i < from.size(); ++i)
-        leaves[i] = {from[i].origin >> Leaf::LOG2DIM, from[i].words};
+    parallelFor(tbb::blocked_range<std::size_t>(0, from.size(), 256), [&](const auto& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i)
+            leaves[i] = {from[i].origin >> Leaf::LOG2DIM, from[i].words};
+    });
     VoxelList out;
     if (!leaves.empty() && dilateInto(leaves.begin(), leaves.end(), radius, out))
         out = eachLeafOnce(std::move(out));

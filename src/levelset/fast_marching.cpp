@@ -129,8 +129,7 @@ class Domain {
     // (dir = +-1) in `sets` (one Bits per leaf); `valid` gets the voxels that have such a
     // neighbour in the domain (0 where it would lie in a leaf outside it).
     template <int A>
-    void stepped(const std::vector<Bits>& sets, std::size_t l, int dir, Bits& out,
-                 Bits& valid) const {
+    void stepped(const Bits* sets, std::size_t l, int dir, Bits& out, Bits& valid) const {
         using namespace leafwords;
         const Word* w = sets[l].data();
         const int nl = neighbours_[l][2 * A + (dir > 0)];
@@ -379,11 +378,12 @@ class Renormalizer {
         : b_(grid, region, 2, only), n_(b_.size()), h_(float(grid.voxelSize()[0])),
           bg_(grid.background()), order_(order), interrupter_(interrupter),
           phi_(b_.leafCount(), nullptr), dist_(new float[n_]), thin_(b_.leafCount(), Bits{}),
-          neg_(b_.leafCount(), Bits{}), fixed_(b_.leafCount(), Bits{}),
-          settled_(b_.leafCount(), Bits{}), beyond_(b_.leafCount(), Bits{}),
+          neg_(new Bits[b_.leafCount()]), fixed_(new Bits[b_.leafCount()]),
+          settled_(new Bits[b_.leafCount()]), beyond_(new Bits[b_.leafCount()]),
           layout_(b_.leafCount(), 2) {
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
-        std::vector<Bits> within; // per leaf, the voxels of `only`
+        std::vector<Bits> freeOf(b_.leafCount()); // per leaf, its free voxels
+        std::vector<Bits> within;                 // per leaf, the voxels of `only`
         if (only) {
             within.resize(b_.leafCount());
             for (const LeafVoxels& leaf : *only) {
@@ -409,19 +409,17 @@ class Renormalizer {
             Bits free = leafwords::inBox(region, leaf.origin());
             if (only) free = free & within[l];
             fixed_[l] = ~free;
+            freeOf[l] = free;
         });
         // The band may have to grow past the free voxels: an inactive voxel next to one is
         // free too (it has no value to keep), to be reached by the solve only: it starts
         // without a value and is never a seed (what it holds is stale). Kept fixed, it stayed
         // off where a free voxel at the edge of `only` came within bg - h of the surface: a
         // hole in the band (the strangle of data/strangle_torus.json left four at 1/32).
-        std::vector<Bits> free(b_.leafCount());
-        for (std::size_t l = 0; l < b_.leafCount(); ++l)
-            free[l] = ~fixed_[l];
         parallelFor(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
             // (Domain::stepped moves a set within the leaf as well as across its faces.)
             const Bits next = nextTo(false, [&](auto a, int dir, Bits& out, Bits& valid) {
-                b_.stepped<decltype(a)::value>(free, l, dir, out, valid);
+                b_.stepped<decltype(a)::value>(freeOf.data(), l, dir, out, valid);
             });
             const auto& active = b_.leaf(l).getValueMask();
             Bits& added = beyond_[l];
@@ -507,7 +505,7 @@ class Renormalizer {
     // Per voxel of leaf l: whether its neighbour along an axis is of the other sign.
     Bits acrossSurface(std::size_t l, bool both) const {
         return nextTo(both, [&](auto a, int dir, Bits& out, Bits& valid) {
-            b_.stepped<decltype(a)::value>(neg_, l, dir, out, valid);
+            b_.stepped<decltype(a)::value>(neg_.get(), l, dir, out, valid);
             for (int x = 0; x < 8; ++x)
                 out[x] ^= neg_[l][x];
         });
@@ -1017,10 +1015,12 @@ class Renormalizer {
     std::vector<Bits> thin_;
     // Per leaf: the voxels inside, the fixed ones (outside the region: boundary values), and
     // those settled before the solve (fixed, and the seeds).
-    std::vector<Bits> neg_, fixed_, settled_;
+    // (Allocated without the serial zeroing of a std::vector: the constructor's parallel
+    // loops write every entry.)
+    std::unique_ptr<Bits[]> neg_, fixed_, settled_;
     // Per leaf: the inactive voxels next to free ones, free so that the band can grow into
     // them.
-    std::vector<Bits> beyond_;
+    std::unique_ptr<Bits[]> beyond_;
     // Per leaf: how its block is laid out and swept (layoutOf).
     std::vector<std::uint8_t> layout_;
     // Per leaf: whether the write-back left it without an active voxel.

@@ -27,7 +27,7 @@ namespace sweepers {
 class SerialClock {
   public:
     // Starts timing; parallel loops called from this thread are accounted to it until it
-    // ends. Clocks nest: the inner one takes the loops while it runs, then hands them back.
+    // ends. Clocks nest: a loop run while an inner clock runs counts in the outer ones too.
     SerialClock() : start_(Clock::now()), outer_(current()) { current() = this; }
     ~SerialClock() { current() = outer_; }
     SerialClock(const SerialClock&) = delete;
@@ -78,8 +78,13 @@ template <typename Range, typename Body> void parallelFor(const Range& range, co
     const double threads = double(std::min<std::size_t>(
         std::size_t(tbb::this_task_arena::max_concurrency()),
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
-    clock->inLoops_ += wall;
-    clock->waited_ += std::max(0.0, wall - 1e-9 * double(busy.load()) / threads);
+    // The clocks around this one see the loop too, up to one that was in a loop itself (a
+    // clock started inside a loop's body: that loop is counted there already).
+    const double waited = std::max(0.0, wall - 1e-9 * double(busy.load()) / threads);
+    for (SerialClock* c = clock; c && (c == clock || !c->inLoop_); c = c->outer_) {
+        c->inLoops_ += wall;
+        c->waited_ += waited;
+    }
 }
 
 // The index form: body(i) for every i in [first, last).

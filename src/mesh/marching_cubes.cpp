@@ -6,6 +6,7 @@
 #include <optional>
 #include <utility>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 #include <xxhash.h>
@@ -215,7 +216,16 @@ class CornerGradients {
 // large enough: re-meshing a segment's leaves allocates little once their chunks have grown.
 // Returns whether the chunk changed: made again, or emptied (a chunk made from the same
 // values, or a leaf without surface that had none, is left as it is).
-bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
+// What a thread meshes a leaf in: the leaf's triangles before they are copied into its
+// chunk, its vertices by edge, and the gradients at its cube corners.
+struct LeafScratch {
+    MeshChunk chunk;
+    LeafVertices vertices;
+    CornerGradients gradients;
+};
+
+bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into,
+              LeafScratch& scratch) {
     const Grid::TreeType::LeafNodeType* leaf = grid.tree().probeConstLeaf(origin);
     std::optional<LeafBlock> block;
     leafwords::Words crossing{};
@@ -235,7 +245,7 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
     // vertex at a time, a new chunk's vectors were allocated again at every doubling (some
     // seven times each for a leaf's sixty or so vertices), and allocating and freeing
     // became a large part of whole-grid meshing.
-    thread_local MeshChunk chunk;
+    MeshChunk& chunk = scratch.chunk;
     chunk.positions.clear();
     chunk.normals.clear();
     chunk.edgeKeys.clear();
@@ -243,9 +253,9 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
     const LeafBlock& values = *block;
     const VoxelPlacement place(grid.transform());
     const double h = grid.voxelSize()[0];
-    thread_local LeafVertices vertices;
+    LeafVertices& vertices = scratch.vertices;
     vertices.clear();
-    thread_local CornerGradients gradients;
+    CornerGradients& gradients = scratch.gradients;
     gradients.clear();
     // Meshes the cube of leaf voxel `offset` (its lowest corner).
     const auto meshCube = [&](int offset) {
@@ -338,6 +348,13 @@ bool meshLeaf(const Grid& grid, const openvdb::Coord& origin, MeshChunk& into) {
 
 } // namespace
 
+struct SurfaceMesher::Scratch : tbb::enumerable_thread_specific<LeafScratch> {};
+
+SurfaceMesher::SurfaceMesher() : scratch_(std::make_unique<Scratch>()) {}
+SurfaceMesher::~SurfaceMesher() = default;
+SurfaceMesher::SurfaceMesher(SurfaceMesher&&) noexcept = default;
+SurfaceMesher& SurfaceMesher::operator=(SurfaceMesher&&) noexcept = default;
+
 std::size_t SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvdb::Coord>& origins,
                                       Interrupter* interrupter) {
     // Each leaf into the chunk it has (its storage reused) or into a new one, which joins
@@ -360,7 +377,7 @@ std::size_t SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvd
             } else {
                 continue; // neither a leaf nor a chunk: nothing to mesh or to empty
             }
-            n += meshLeaf(grid, origins[i], *into[i]);
+            n += meshLeaf(grid, origins[i], *into[i], scratch_->local());
         }
         meshed += n;
     });

@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <map>
+#include <memory>
 #include <vector>
 
 #include "levelset/interrupt.h"
@@ -39,6 +40,11 @@ struct MeshChanges {
 
 class SurfaceMesher {
   public:
+    SurfaceMesher();
+    ~SurfaceMesher();
+    SurfaceMesher(SurfaceMesher&&) noexcept;
+    SurfaceMesher& operator=(SurfaceMesher&&) noexcept;
+
     // Meshes every active leaf; a cancelled rebuild (Cancelled) changes nothing.
     void rebuild(const Grid& grid, Interrupter* interrupter = nullptr);
     // Re-meshes the leaves overlapping `touched` grown by two voxels (as far as a leaf's
@@ -66,6 +72,9 @@ class SurfaceMesher {
                            Interrupter* interrupter = nullptr);
     std::map<openvdb::Coord, MeshChunk> chunks_;
     MeshChanges changes_{true, {}};
+    // Per thread, what a leaf is meshed in: kept from one update to the next.
+    struct Scratch;
+    std::unique_ptr<Scratch> scratch_;
 };
 
 // Convenience: the welded mesh of a whole grid.

@@ -31,12 +31,15 @@ struct SegmentReport {
     // AdvectStats times.
     double advectSeconds() const { return seconds - stats.renormalizeSeconds; }
     double meshSerialSeconds = 0.0; // of the re-meshing, on one thread while others waited
-    // The segment's serial time (levelset/parallel.h): each stage's, the set-up and clean-up
-    // around them, which run on one thread, and the re-meshing's.
+    // The segment's serial time (levelset/parallel.h): each phase's, what runs around the
+    // phases on one thread, and the re-meshing's.
     double serialSeconds() const {
-        const double stages = stats.growSeconds + stats.sampleSeconds + stats.renormalizeSeconds;
-        return stats.growSerialSeconds + stats.sampleSerialSeconds +
-               stats.renormalizeSerialSeconds + std::max(0.0, seconds - stages) + meshSerialSeconds;
+        double phases = 0.0, serial = meshSerialSeconds;
+        for (const AdvectStats::PhaseTime& p : stats.phases) {
+            phases += p.seconds;
+            serial += p.serialSeconds;
+        }
+        return serial + std::max(0.0, seconds - phases);
     }
     std::size_t remeshedLeaves = 0;
     double meshVolume = 0.0; // enclosed volume of the mesh after the segment (applyStrokes,

@@ -47,6 +47,19 @@ void addSegmentCounters(benchmark::State& state, const std::vector<SegmentReport
     // The share of the segments' time during which one thread worked and the others waited
     // (levelset/parallel.h): at one thread, Amdahl's bound on what more cores can give.
     state.counters["serial_fraction"] = allTime > 0.0 ? allSerial / allTime : 0.0;
+    // Where it is: each phase's serial time, mean per segment.
+    for (std::size_t k = 0; k < kAdvectPhases.size(); ++k) {
+        double serialOfPhase = 0.0;
+        for (const SegmentReport& r : reports)
+            serialOfPhase += r.stats.phases[k].serialSeconds;
+        state.counters[std::string(kAdvectPhases[k]) + "_serial_ms"] =
+            1e3 * serialOfPhase / double(std::max<std::size_t>(reports.size(), 1));
+    }
+    double meshSerial = 0.0;
+    for (const SegmentReport& r : reports)
+        meshSerial += r.meshSerialSeconds;
+    state.counters["mesh_serial_ms"] =
+        1e3 * meshSerial / double(std::max<std::size_t>(reports.size(), 1));
     state.counters["segments"] = double(reports.size());
 }
 

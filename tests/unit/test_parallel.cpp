@@ -51,16 +51,22 @@ TEST(SerialClock, ABalancedLoopAddsLittle) {
 }
 
 TEST(SerialClock, ClocksNestAndLoopsInsideLoopsCountOnce) {
+    // Two threads, a balanced loop of 8 x 10 ms under an inner clock: neither clock counts
+    // it as serial, so both stay well below the loop's 40 ms and more.
+    const tbb::global_control two(tbb::global_control::max_allowed_parallelism, 2);
     const SerialClock outer;
     {
         const SerialClock inner;
-        sleepMs(20);
-        EXPECT_GE(inner.serialSeconds(), 0.020);
+        parallelFor(tbb::blocked_range<std::size_t>(0, 8, 1), [](const auto& r) {
+            for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                // A loop inside a loop's body counts once, in the outer loop.
+                parallelFor(std::size_t(0), std::size_t(4), [](std::size_t) {});
+                sleepMs(10);
+            }
+        });
+        EXPECT_LT(inner.serialSeconds(), inner.wallSeconds() - 0.015);
     }
-    // The inner clock took its loops while it ran; the outer one sees its time as its own.
-    parallelFor(std::size_t(0), std::size_t(4), [](std::size_t) {
-        parallelFor(std::size_t(0), std::size_t(4), [](std::size_t) {});
-    });
-    EXPECT_GE(outer.serialSeconds(), 0.020);
     EXPECT_EQ(SerialClock::current(), &outer);
+    EXPECT_GE(outer.wallSeconds(), 0.040 - 0.002);
+    EXPECT_LT(outer.serialSeconds(), outer.wallSeconds() - 0.015);
 }
