@@ -524,11 +524,13 @@ void makeLeavesWithin(Grid& grid, const VoxelList& mask, int beyond,
     std::sort(origins.begin(), origins.end());
     origins.erase(std::unique(origins.begin(), origins.end()), origins.end());
     std::vector<LeafNode*> made(origins.size());
-    parallelFor(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
-        const auto acc = grid.getConstAccessor();
-        for (std::size_t i = r.begin(); i != r.end(); ++i)
-            made[i] = new LeafNode(origins[i], acc.getValue(origins[i]), acc.isValueOn(origins[i]));
-    });
+    parallelFor(tbb::blocked_range<std::size_t>(0, origins.size(), grainFor(origins.size(), 16)),
+                [&](const auto& r) {
+                    const auto acc = grid.getConstAccessor();
+                    for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        made[i] = new LeafNode(origins[i], acc.getValue(origins[i]),
+                                               acc.isValueOn(origins[i]));
+                });
     for (LeafNode* leaf : made)
         grid.tree().addLeaf(leaf);
 }
@@ -756,67 +758,70 @@ void SegmentAdvector::Work::mapImages() {
     measureStretch = neededFor(seg->stretchBound()) > halfWidth;
     fit(stretchAt, interface.size() / kStretchSampling + 1);
     std::fill(stretchAt.begin(), stretchAt.end(), 1.0);
-    parallelFor(tbb::blocked_range<std::size_t>(0, interface.size(), 64), [&](const auto& r) {
-        pollInterrupt(options->interrupter);
-        Mapping& m = mapping.local();
-        VoxelList& marked = m.marked;
-        const std::size_t run = marked.size(); // this run's entries start here
-        // The images of a run of voxels next to each other fall into a few leaves: its
-        // entries are searched from the one marked last.
-        std::size_t last = run;
-        const auto mark = [&](const openvdb::Coord& c) {
-            const openvdb::Coord origin = c & ~int(LeafNode::DIM - 1);
-            if (last == marked.size() || marked[last].origin != origin) {
-                last = run;
-                while (last < marked.size() && marked[last].origin != origin)
-                    ++last;
-                if (last == marked.size()) marked.push_back({origin, {}});
-            }
-            const openvdb::Index off = LeafNode::coordToOffset(c);
-            marked[last].words[off >> 6] |= leafwords::Word(1) << (off & 63);
-        };
-        // The range's voxels are mapped a sub-step at a time, a batch of them at once (a
-        // batch of fixed size, so that the buffers need no more room however the loop is
-        // split among the threads).
-        std::vector<Eigen::Vector3d>&mapped = m.mapped, &next = m.next;
-        if (mapped.capacity() < kMapBatch) {
-            mapped.reserve(kMapBatch);
-            next.reserve(kMapBatch);
-        }
-        for (std::size_t b = r.begin(); b < r.end(); b += kMapBatch) {
-            const std::size_t e = std::min(b + kMapBatch, r.end());
-            mapped.resize(e - b);
-            next.resize(e - b);
-            for (std::size_t i = b; i != e; ++i)
-                mapped[i - b] = toEigen(place.toWorld(interface[i].asVec3d()));
-            for (int k = 0; k < seg->steps(); ++k) {
-                seg->forwardSteps(k, mapped.data(), mapped.size(), forwardTolerance, next.data(),
-                                  m.maps);
-                mapped.swap(next);
-                // Intermediate surfaces only need a band when they are stored.
-                if (options->resampleEachSubStep || k + 1 == seg->steps())
-                    for (const Eigen::Vector3d& p : mapped)
-                        mark(openvdb::Coord::round(place.toIndex(toVdb(p))));
-            }
-            for (std::size_t i = b; i != e; ++i) {
-                const Eigen::Vector3d& p = mapped[i - b];
-                if (!measureStretch || i % kStretchSampling != 0) continue;
-                // How far the inverse map can spread a voxel-sized neighbourhood of the new
-                // surface: the largest singular value of its Jacobian.
-                Eigen::Matrix3d J;
-                for (int a = 0; a < 3; ++a) {
-                    Eigen::Vector3d e = Eigen::Vector3d::Zero();
-                    e[a] = 0.5 * h;
-                    J.col(a) = (seg->inverseMap(p + e) - seg->inverseMap(p - e)) / h;
+    parallelFor(
+        tbb::blocked_range<std::size_t>(0, interface.size(), grainFor(interface.size(), 64)),
+        [&](const auto& r) {
+            pollInterrupt(options->interrupter);
+            Mapping& m = mapping.local();
+            VoxelList& marked = m.marked;
+            const std::size_t run = marked.size(); // this run's entries start here
+            // The images of a run of voxels next to each other fall into a few leaves: its
+            // entries are searched from the one marked last.
+            std::size_t last = run;
+            const auto mark = [&](const openvdb::Coord& c) {
+                const openvdb::Coord origin = c & ~int(LeafNode::DIM - 1);
+                if (last == marked.size() || marked[last].origin != origin) {
+                    last = run;
+                    while (last < marked.size() && marked[last].origin != origin)
+                        ++last;
+                    if (last == marked.size()) marked.push_back({origin, {}});
                 }
-                // Its square is the largest eigenvalue of J^T J, solved in closed form (an
-                // iterative SVD of J costs more than the six inverse maps).
-                Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
-                eigen.computeDirect(J.transpose() * J, Eigen::EigenvaluesOnly);
-                stretchAt[i / kStretchSampling] = std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
+                const openvdb::Index off = LeafNode::coordToOffset(c);
+                marked[last].words[off >> 6] |= leafwords::Word(1) << (off & 63);
+            };
+            // The range's voxels are mapped a sub-step at a time, a batch of them at once (a
+            // batch of fixed size, so that the buffers need no more room however the loop is
+            // split among the threads).
+            std::vector<Eigen::Vector3d>&mapped = m.mapped, &next = m.next;
+            if (mapped.capacity() < kMapBatch) {
+                mapped.reserve(kMapBatch);
+                next.reserve(kMapBatch);
             }
-        }
-    });
+            for (std::size_t b = r.begin(); b < r.end(); b += kMapBatch) {
+                const std::size_t e = std::min(b + kMapBatch, r.end());
+                mapped.resize(e - b);
+                next.resize(e - b);
+                for (std::size_t i = b; i != e; ++i)
+                    mapped[i - b] = toEigen(place.toWorld(interface[i].asVec3d()));
+                for (int k = 0; k < seg->steps(); ++k) {
+                    seg->forwardSteps(k, mapped.data(), mapped.size(), forwardTolerance,
+                                      next.data(), m.maps);
+                    mapped.swap(next);
+                    // Intermediate surfaces only need a band when they are stored.
+                    if (options->resampleEachSubStep || k + 1 == seg->steps())
+                        for (const Eigen::Vector3d& p : mapped)
+                            mark(openvdb::Coord::round(place.toIndex(toVdb(p))));
+                }
+                for (std::size_t i = b; i != e; ++i) {
+                    const Eigen::Vector3d& p = mapped[i - b];
+                    if (!measureStretch || i % kStretchSampling != 0) continue;
+                    // How far the inverse map can spread a voxel-sized neighbourhood of the new
+                    // surface: the largest singular value of its Jacobian.
+                    Eigen::Matrix3d J;
+                    for (int a = 0; a < 3; ++a) {
+                        Eigen::Vector3d e = Eigen::Vector3d::Zero();
+                        e[a] = 0.5 * h;
+                        J.col(a) = (seg->inverseMap(p + e) - seg->inverseMap(p - e)) / h;
+                    }
+                    // Its square is the largest eigenvalue of J^T J, solved in closed form (an
+                    // iterative SVD of J costs more than the six inverse maps).
+                    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen;
+                    eigen.computeDirect(J.transpose() * J, Eigen::EigenvaluesOnly);
+                    stretchAt[i / kStretchSampling] =
+                        std::sqrt(std::max(0.0, eigen.eigenvalues()[2]));
+                }
+            }
+        });
     // Each thread's list keeps room for twice what it marked this time.
     for (Mapping& m : mapping)
         if (m.marked.capacity() < 2 * m.marked.size()) m.marked.reserve(2 * m.marked.size());
@@ -885,11 +890,12 @@ VoxelList SegmentAdvector::Work::switchOn(const VoxelList& on) {
     // Most of the leaves are there already: they are found in parallel (reading the tree),
     // and only the missing ones are made, on this thread (the tree changes).
     std::vector<LeafNode*> to(from.size());
-    parallelFor(tbb::blocked_range<std::size_t>(0, from.size(), 64), [&](const auto& r) {
-        const auto acc = grid->getConstAccessor();
-        for (std::size_t i = r.begin(); i != r.end(); ++i)
-            to[i] = const_cast<LeafNode*>(acc.probeConstLeaf(from[i]->origin));
-    });
+    parallelFor(tbb::blocked_range<std::size_t>(0, from.size(), grainFor(from.size(), 64)),
+                [&](const auto& r) {
+                    const auto acc = grid->getConstAccessor();
+                    for (std::size_t i = r.begin(); i != r.end(); ++i)
+                        to[i] = const_cast<LeafNode*>(acc.probeConstLeaf(from[i]->origin));
+                });
     {
         auto into = grid->getAccessor();
         for (std::size_t i = 0; i < from.size(); ++i)

@@ -115,18 +115,19 @@ template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box,
     // read); the few new leaves are then added on this thread, in the list's order.
     const std::size_t count = leaves.size();
     std::vector<std::uint8_t> reaches(count);
-    parallelFor(tbb::blocked_range<std::size_t>(0, count, 256), [&](const auto& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-            std::uint8_t sides = 0;
-            for (const int dir : {-1, 1}) {
-                openvdb::Coord c = leaves[i].at;
-                c[Axis] += dir;
-                if (box.get(c) < 0 && spills<Axis>(leaves[i].bits, dir, r))
-                    sides |= dir < 0 ? 1 : 2;
-            }
-            reaches[i] = sides;
-        }
-    });
+    parallelFor(tbb::blocked_range<std::size_t>(0, count, grainFor(count, 256)),
+                [&](const auto& range) {
+                    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        std::uint8_t sides = 0;
+                        for (const int dir : {-1, 1}) {
+                            openvdb::Coord c = leaves[i].at;
+                            c[Axis] += dir;
+                            if (box.get(c) < 0 && spills<Axis>(leaves[i].bits, dir, r))
+                                sides |= dir < 0 ? 1 : 2;
+                        }
+                        reaches[i] = sides;
+                    }
+                });
     for (std::size_t i = 0; i < count; ++i)
         for (const int dir : {-1, 1}) {
             if (!(reaches[i] & (dir < 0 ? 1 : 2))) continue;
@@ -137,22 +138,24 @@ template <int Axis> void dilateList(std::vector<MaskLeaf>& leaves, LeafBox& box,
             leaves.push_back({c, Bits{}});
         }
     std::vector<Bits> out(leaves.size());
-    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size(), 64), [&](const auto& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-            openvdb::Coord c = leaves[i].at;
-            c[Axis] -= 1;
-            const int b = box.get(c);
-            c[Axis] += 2;
-            const int a = box.get(c);
-            out[i] =
-                dilatedAlong<Axis>(leaves[i].bits, b < 0 ? nullptr : &leaves[std::size_t(b)].bits,
-                                   a < 0 ? nullptr : &leaves[std::size_t(a)].bits, r);
-        }
-    });
-    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size(), 256), [&](const auto& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i)
-            leaves[i].bits = out[i];
-    });
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size(), grainFor(leaves.size(), 64)),
+                [&](const auto& range) {
+                    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        openvdb::Coord c = leaves[i].at;
+                        c[Axis] -= 1;
+                        const int b = box.get(c);
+                        c[Axis] += 2;
+                        const int a = box.get(c);
+                        out[i] = dilatedAlong<Axis>(
+                            leaves[i].bits, b < 0 ? nullptr : &leaves[std::size_t(b)].bits,
+                            a < 0 ? nullptr : &leaves[std::size_t(a)].bits, r);
+                    }
+                });
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size(), grainFor(leaves.size(), 256)),
+                [&](const auto& range) {
+                    for (std::size_t i = range.begin(); i != range.end(); ++i)
+                        leaves[i].bits = out[i];
+                });
 }
 
 // Dilates the leaves of [begin, end) by the cube of half-side `radius`, onto the end of
@@ -205,15 +208,17 @@ bool dilateInto(std::vector<MaskLeaf>::iterator begin, std::vector<MaskLeaf>::it
     }
     const std::size_t first = out.size();
     out.resize(first + leaves.size());
-    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size(), 256), [&](const auto& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i) {
-            const MaskLeaf& leaf = leaves[i];
-            // (Multiplied, not shifted: a left shift of a negative coordinate is undefined.)
-            out[first + i] = {
-                openvdb::Coord(leaf.at.x() * kDim, leaf.at.y() * kDim, leaf.at.z() * kDim),
-                leaf.bits};
-        }
-    });
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size(), grainFor(leaves.size(), 256)),
+                [&](const auto& range) {
+                    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+                        const MaskLeaf& leaf = leaves[i];
+                        // (Multiplied, not shifted: a left shift of a negative coordinate is
+                        // undefined.)
+                        out[first + i] = {openvdb::Coord(leaf.at.x() * kDim, leaf.at.y() * kDim,
+                                                         leaf.at.z() * kDim),
+                                          leaf.bits};
+                    }
+                });
     return false;
 }
 
@@ -223,10 +228,11 @@ VoxelList dilatedByCube(const VoxelList& from, int radius) {
     if (radius < 0) throw std::invalid_argument("dilatedByCube: a negative radius");
     if (radius == 0) return eachLeafOnce(from);
     std::vector<MaskLeaf> leaves(from.size());
-    parallelFor(tbb::blocked_range<std::size_t>(0, from.size(), 256), [&](const auto& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i)
-            leaves[i] = {from[i].origin >> Leaf::LOG2DIM, from[i].words};
-    });
+    parallelFor(tbb::blocked_range<std::size_t>(0, from.size(), grainFor(from.size(), 256)),
+                [&](const auto& range) {
+                    for (std::size_t i = range.begin(); i != range.end(); ++i)
+                        leaves[i] = {from[i].origin >> Leaf::LOG2DIM, from[i].words};
+                });
     VoxelList out;
     if (!leaves.empty() && dilateInto(leaves.begin(), leaves.end(), radius, out))
         out = eachLeafOnce(std::move(out));

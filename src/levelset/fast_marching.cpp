@@ -754,7 +754,8 @@ class Renormalizer {
             for (const auto& leavesOfClass : classes) {
                 pollInterrupt(interrupter_);
                 parallelFor(
-                    tbb::blocked_range<std::size_t>(0, leavesOfClass.size(), 4),
+                    tbb::blocked_range<std::size_t>(0, leavesOfClass.size(),
+                                                    grainFor(leavesOfClass.size(), 4)),
                     [&](const auto& r) {
                         Block& block = blocks.local();
                         for (std::size_t q = r.begin(); q != r.end(); ++q) {

@@ -52,6 +52,21 @@ class SerialClock {
     bool inLoop_ = false; // a loop's body may start loops of its own: only the outer one counts
 };
 
+// The threads a loop started now may use: the arena's, within what a global_control
+// (--threads) allows.
+inline std::size_t loopThreads() {
+    return std::min<std::size_t>(
+        std::size_t(tbb::this_task_arena::max_concurrency()),
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
+// The grain of a loop over n items: small enough that each thread gets several chunks (a
+// loop's tail then waits for a small chunk, not a large one), and at most `most`, the
+// chunk that amortizes a task's cost for items this cheap.
+inline std::size_t grainFor(std::size_t n, std::size_t most) {
+    return std::clamp<std::size_t>(n / (8 * loopThreads()), 1, most);
+}
+
 // tbb::parallel_for over `range`, accounted to the calling thread's SerialClock if one runs.
 template <typename Range, typename Body> void parallelFor(const Range& range, const Body& body) {
     SerialClock* clock = SerialClock::current();
@@ -73,11 +88,7 @@ template <typename Range, typename Body> void parallelFor(const Range& range, co
         busy += std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - t).count();
     });
     const double wall = secondsSince(start);
-    // The threads the loop may use: the arena's, within what a global_control (--threads)
-    // allows.
-    const double threads = double(std::min<std::size_t>(
-        std::size_t(tbb::this_task_arena::max_concurrency()),
-        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism)));
+    const double threads = double(loopThreads());
     // The clocks around this one see the loop too, up to one that was in a loop itself (a
     // clock started inside a loop's body: that loop is counted there already).
     const double waited = std::max(0.0, wall - 1e-9 * double(busy.load()) / threads);

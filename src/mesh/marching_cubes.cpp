@@ -365,22 +365,24 @@ std::size_t SurfaceMesher::meshLeaves(const Grid& grid, const std::vector<openvd
     std::vector<MeshChunk*> into(origins.size());
     std::vector<MeshChunk> fresh(origins.size());
     std::atomic<std::size_t> meshed{0};
-    parallelFor(tbb::blocked_range<std::size_t>(0, origins.size(), 16), [&](const auto& r) {
-        pollInterrupt(interrupter);
-        std::size_t n = 0;
-        for (std::size_t i = r.begin(); i != r.end(); ++i) {
-            const auto it = chunks_.find(origins[i]); // (find counts as const for races)
-            if (it != chunks_.end()) {
-                into[i] = &it->second;
-            } else if (grid.tree().probeConstLeaf(origins[i])) {
-                into[i] = &fresh[i];
-            } else {
-                continue; // neither a leaf nor a chunk: nothing to mesh or to empty
-            }
-            n += meshLeaf(grid, origins[i], *into[i], scratch_->local());
-        }
-        meshed += n;
-    });
+    parallelFor(tbb::blocked_range<std::size_t>(0, origins.size(), grainFor(origins.size(), 16)),
+                [&](const auto& r) {
+                    pollInterrupt(interrupter);
+                    std::size_t n = 0;
+                    for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                        const auto it =
+                            chunks_.find(origins[i]); // (find counts as const for races)
+                        if (it != chunks_.end()) {
+                            into[i] = &it->second;
+                        } else if (grid.tree().probeConstLeaf(origins[i])) {
+                            into[i] = &fresh[i];
+                        } else {
+                            continue; // neither a leaf nor a chunk: nothing to mesh or to empty
+                        }
+                        n += meshLeaf(grid, origins[i], *into[i], scratch_->local());
+                    }
+                    meshed += n;
+                });
     for (std::size_t i = 0; i < origins.size(); ++i) {
         if (!into[i]) continue;
         if (into[i] == &fresh[i]) {
@@ -510,7 +512,7 @@ TriangleMesh SurfaceMesher::weld() const {
         list.emplace_back(origin, &chunk);
     const std::size_t n = list.size();
     const auto forEachChunk = [&](const auto& body) {
-        parallelFor(tbb::blocked_range<std::size_t>(0, n, 64), [&](const auto& r) {
+        parallelFor(tbb::blocked_range<std::size_t>(0, n, grainFor(n, 64)), [&](const auto& r) {
             for (std::size_t c = r.begin(); c != r.end(); ++c)
                 body(c, *list[c].second);
         });
