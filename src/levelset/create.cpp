@@ -2,6 +2,7 @@
 
 #include <mutex>
 
+#include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/MeshToVolume.h>
 
@@ -60,6 +61,13 @@ GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
 }
 
 void markAsDocument(Grid& grid) {
+    // A band of the half-width its background says, as the float that holds it reads back:
+    // tools that require a band of some width (OpenVDB's checkLevelSet, its trackers and
+    // filters) divide the background by the voxel size. Raised by a unit in the last place
+    // where needed; only inactive values change.
+    const float background = bandBackground(grid.voxelSize()[0], halfWidthOf(grid));
+    if (grid.background() < background)
+        openvdb::tools::changeLevelSetBackground(grid.tree(), background);
     grid.setName("surface");
     grid.setGridClass(openvdb::GRID_LEVEL_SET);
     grid.insertMeta("creator", openvdb::StringMetadata("sweepers " SWEEPERS_VERSION));

@@ -30,7 +30,8 @@ GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
                          double halfWidth, Interrupter* interrupter = nullptr);
 
 // Names the grid "surface" and stamps the metadata of the file contract (creator:
-// "sweepers VERSION", half_width).
+// "sweepers VERSION", half_width), and makes its background read back as at least its
+// half-width in voxels (bandBackground).
 void markAsDocument(Grid& grid);
 
 } // namespace sweepers

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Core>
 #include <openvdb/openvdb.h>
@@ -50,6 +51,16 @@ class VoxelPlacement {
 // simple fractions of a voxel: the quotient is rounded to 1/1024 of a voxel.
 inline double halfWidthOf(const Grid& grid) {
     return std::round(double(grid.background()) / grid.voxelSize()[0] * 1024.0) / 1024.0;
+}
+
+// The background of a band `halfWidth` voxels wide: the float nearest halfWidth x voxel
+// size, or the next one up where that one, divided by the voxel size as OpenVDB's checks
+// and tools read it back, falls short of the half-width (0.06f / 0.02 is 2.99999993).
+inline float bandBackground(double voxelSize, double halfWidth) {
+    float b = float(halfWidth * voxelSize);
+    while (double(b) / voxelSize < halfWidth)
+        b = std::nextafter(b, std::numeric_limits<float>::infinity());
+    return b;
 }
 
 // Makes sure OpenVDB's grid registry is set up (idempotent, thread-safe).

@@ -23,6 +23,29 @@ assert abs(g.background - 3 * 0.025) < 1e-7, g.background
 assert g["creator"] == sys.argv[2], (g.metadata, sys.argv[2])
 PY
 
+# --- the background reads back as the band's half-width at least ----------------------
+# (OpenVDB's checkLevelSet and tools divide it by the voxel size: a float nearest 3 x 0.02
+# reads back as 2.99999993 voxels.) Voxel sizes where the float nearest the product lies
+# below it, and half-widths 3 and 5.
+for hw in 3 5; do
+  "$py" - "$data/pull.json" "$tmp/pull_$hw.json" "$hw" <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+s["grid"]["half_width"] = float(sys.argv[3])
+json.dump(s, open(sys.argv[2], "w"))
+PY
+  for h in 0.02 0.07 0.011; do
+    "$cli" apply "$tmp/pull_$hw.json" -o "$tmp/bg.vdb" --voxel-size "$h" -q
+    "$py" - "$tmp/bg.vdb" "$hw" "$h" <<'PY' || fail "background at half-width $hw, voxel size $h"
+import sys, pyopenvdb as vdb
+g = vdb.read(sys.argv[1], "surface")
+width = g.background / g.transform.voxelSize()[0]
+assert width >= float(sys.argv[2]), (sys.argv[2:], g.background, width)
+PY
+  done
+done
+echo "background: at least the half-width at voxel sizes 0.02, 0.07, 0.011, half-widths 3 and 5"
+
 # --- apply a real script, export a mesh, check the numbers --------------------------
 "$cli" apply "$data/horn.json" -o "$tmp/horn.vdb" --voxel-size 0.03125 --mesh "$tmp/horn.stl" 2>"$tmp/log"
 grep -q "volume" "$tmp/log" || fail "apply printed no volume"
