@@ -11,7 +11,6 @@
 #include <tbb/parallel_sort.h>
 #include <xxhash.h>
 
-#include "levelset/leaf_box.h"
 #include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
 #include "levelset/parallel.h"
@@ -471,12 +470,38 @@ std::size_t SurfaceMesher::update(const Grid& grid,
     std::vector<openvdb::Coord> origins;
     const std::size_t cells = extent.empty() ? 0 : extent.volume();
     if (cells <= 2 * marks + 4096) {
-        LeafBox marked(extent.min(), extent.max()); // 0 where a leaf reads a box
-        for (const openvdb::CoordBBox& r : read)
-            for (auto it = r.begin(); it; ++it)
-                marked.at(*it) = 0;
-        for (auto it = extent.begin(); it; ++it)
-            if (marked.get(*it) == 0) origins.push_back(originAt(*it));
+        // Marked by the boxes in parallel (boxes overlap: each mark is an atomic store of the
+        // same 1), then listed an x-slab of the extent per task, in the extent's order.
+        const openvdb::Coord lo = extent.min(), n = extent.dim();
+        const auto slot = [&](const openvdb::Coord& c) {
+            const openvdb::Coord d = c - lo;
+            return (std::size_t(d.x()) * std::size_t(n.y()) + std::size_t(d.y())) *
+                       std::size_t(n.z()) +
+                   std::size_t(d.z());
+        };
+        std::unique_ptr<std::atomic<std::uint8_t>[]> marked(new std::atomic<std::uint8_t>[cells]);
+        parallelFor(tbb::blocked_range<std::size_t>(0, cells, grainFor(cells, 4096)),
+                    [&](const auto& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i)
+                            marked[i].store(0, std::memory_order_relaxed);
+                    });
+        parallelFor(tbb::blocked_range<std::size_t>(0, read.size(), grainFor(read.size(), 64)),
+                    [&](const auto& r) {
+                        for (std::size_t i = r.begin(); i != r.end(); ++i)
+                            for (auto it = read[i].begin(); it; ++it)
+                                marked[slot(*it)].store(1, std::memory_order_relaxed);
+                    });
+        std::vector<std::vector<openvdb::Coord>> slabs(std::size_t(n.x()));
+        parallelFor(std::size_t(0), slabs.size(), [&](std::size_t x) {
+            for (int y = 0; y < n.y(); ++y)
+                for (int z = 0; z < n.z(); ++z) {
+                    const openvdb::Coord c = lo.offsetBy(int(x), y, z);
+                    if (marked[slot(c)].load(std::memory_order_relaxed))
+                        slabs[x].push_back(originAt(c));
+                }
+        });
+        for (const auto& slab : slabs)
+            origins.insert(origins.end(), slab.begin(), slab.end());
     } else {
         for (const openvdb::CoordBBox& r : read)
             for (auto it = r.begin(); it; ++it)
