@@ -798,11 +798,10 @@ class Modeler {
         if (ImGui::BeginCombo("detail", current)) {
             for (const int n : kDetailLevels) {
                 const double h = 1.0 / n;
-                char item[96];
-                std::snprintf(item, sizeof item, "1/%d  (about %.0f MB)", n,
-                              std::ceil(memoryAtVoxelSize(h) / (1 << 20)));
+                const std::string item = "1/" + std::to_string(n) + "  (about " +
+                                         formatBytes(memoryAtVoxelSize(h)) + ")";
                 const bool now = std::abs(h - info_.voxelSize) < 1e-9 * h;
-                if (ImGui::Selectable(item, now) && !now) {
+                if (ImGui::Selectable(item.c_str(), now) && !now) {
                     voxelSizeInput_ = float(h);
                     resampleTo(h);
                 }

@@ -3,7 +3,6 @@
 // 1 input refused or the work failed, 2 a usage error, 3 a study that finished with runs
 // failed (or without its plots), 130 interrupted.
 #include <algorithm>
-#include <chrono>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -332,7 +331,7 @@ int runApply(const ApplyArgs& a) {
     const double before = report ? levelSetVolume(grid) : 0.0;
     if (a.stats) sculptor.startMeshing();
     const double meshBefore = a.stats ? sculptor.mesher().enclosedVolume() : 0.0;
-    const auto wallStart = std::chrono::steady_clock::now();
+    const auto wallStart = Clock::now();
     std::vector<SegmentReport> reports;
     {
         ProgressLine progress(gOut.progress(), "applying " + a.script, "segment");
@@ -404,8 +403,7 @@ int runApply(const ApplyArgs& a) {
     }
     vdb.commit();
     if (meshFile) meshFile->commit();
-    const double wall =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - wallStart).count();
+    const double wall = secondsSince(wallStart);
     const double after = report ? levelSetVolume(grid) : 0.0;
     char line[256];
     std::snprintf(line, sizeof line,

@@ -34,14 +34,14 @@ ProgressMode progressModeFor(bool quiet, std::FILE* file) {
 
 ProgressLine::ProgressLine(ProgressMode mode, std::string what, std::string unit, std::FILE* file)
     : mode_(mode), what_(std::move(what)), unit_(std::move(unit)), file_(file),
-      start_(std::chrono::steady_clock::now()) {}
+      start_(Clock::now()) {}
 
 ProgressLine::~ProgressLine() {
     finish();
 }
 
 double ProgressLine::elapsed() const {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    return secondsSince(start_);
 }
 
 std::string ProgressLine::status(std::size_t done, std::size_t total, bool bar) const {

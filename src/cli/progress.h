@@ -6,10 +6,11 @@
 //  - with -q, nothing: errors are the caller's to print.
 #pragma once
 
-#include <chrono>
 #include <cstddef>
 #include <cstdio>
 #include <string>
+
+#include "core/stopwatch.h"
 
 namespace sweepers::cli {
 
@@ -45,7 +46,7 @@ class ProgressLine {
     ProgressMode mode_;
     std::string what_, unit_;
     std::FILE* file_;
-    std::chrono::steady_clock::time_point start_;
+    Clock::time_point start_;
     double lastDraw_ = -1.0;
     long lastTenth_ = -1;
     bool drawn_ = false, eachTenth_ = true;

@@ -627,14 +627,17 @@ struct SegmentAdvector::Work {
     GridPtr widened; // the copies with the widened band, when it had to be widened
     std::vector<LeafNode*> sampled, moving;
 
-    // Sizes a kept buffer for n entries, counting when its storage has to grow.
-    // A buffer that grows takes room for twice what is asked: the next segments of a stroke
+    // Gives a kept buffer room for n entries, counting when its storage has to grow. A
+    // buffer that grows takes room for twice what is asked: the next segments of a stroke
     // ask for about as much, a little more where the shape grew.
+    template <typename Vector> void makeRoom(Vector& v, std::size_t n) {
+        if (n <= v.capacity()) return;
+        v.reserve(std::max(2 * n, 2 * v.capacity()));
+        ++growths;
+    }
+    // Sizes a kept buffer for n entries.
     template <typename Vector> void fit(Vector& v, std::size_t n) {
-        if (n > v.capacity()) {
-            v.reserve(std::max(2 * n, 2 * v.capacity()));
-            ++growths;
-        }
+        makeRoom(v, n);
         v.resize(n);
     }
 
@@ -828,11 +831,7 @@ void SegmentAdvector::Work::mapImages() {
     std::size_t count = 0;
     for (const Mapping& m : mapping)
         count += m.marked.size();
-    fit(images, 0);
-    if (count > images.capacity()) {
-        images.reserve(std::max(2 * count, 2 * images.capacity()));
-        ++growths;
-    }
+    makeRoom(images, count);
     for (const Mapping& m : mapping)
         images.insert(images.end(), m.marked.begin(), m.marked.end());
     if (measureStretch)
