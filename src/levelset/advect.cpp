@@ -1125,17 +1125,10 @@ AdvectStats SegmentAdvector::run(Grid& grid, const StepDeformation& segment,
     phase(4, [&] { w.sample(); });
     phase(5, [&] { w.fixSigns(); });
     phase(6, [&] { w.renormalizeChanged(); });
-    const auto sum = [&](std::size_t a, std::size_t b, double AdvectStats::PhaseTime::*part) {
-        double t = 0.0;
-        for (std::size_t k = a; k < b; ++k)
-            t += stats.phases[k].*part;
-        return t;
-    };
-    using P = AdvectStats::PhaseTime;
-    stats.growSeconds = sum(0, 4, &P::seconds);
-    stats.growSerialSeconds = sum(0, 4, &P::serialSeconds);
-    stats.sampleSeconds = sum(4, 6, &P::seconds);
-    stats.sampleSerialSeconds = sum(4, 6, &P::serialSeconds);
+    const auto& p = stats.phases;
+    stats.growSeconds = p[0].seconds + p[1].seconds + p[2].seconds + p[3].seconds;
+    stats.sampleSeconds = p[4].seconds + p[5].seconds;
+    stats.renormalizeSeconds = p[6].seconds;
     stats.touched = w.touched;
     phase(7, [&] {
         w.report(changed);
@@ -1144,8 +1137,6 @@ AdvectStats SegmentAdvector::run(Grid& grid, const StepDeformation& segment,
         w.sampled.clear();
         w.moving.clear();
     });
-    stats.renormalizeSeconds = stats.phases[6].seconds;
-    stats.renormalizeSerialSeconds = stats.phases[6].serialSeconds;
     return stats;
 }
 

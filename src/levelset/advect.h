@@ -60,11 +60,10 @@ struct AdvectStats {
     std::size_t leavesFlooded = 0; // whose inactive signs were re-derived
     std::size_t tornVoxels = 0;    // inside voxels beyond the band that a tear opened
     double growSeconds = 0.0, sampleSeconds = 0.0, renormalizeSeconds = 0.0;
-    // Of each, the time one thread worked while the others waited (levelset/parallel.h):
-    // what more cores cannot shorten.
-    double growSerialSeconds = 0.0, sampleSerialSeconds = 0.0, renormalizeSerialSeconds = 0.0;
-    // The same for each phase of SegmentAdvector, in the order of kAdvectPhases (the first
-    // four make band growth, the next two sampling, the last two renormalization).
+    // Each phase of SegmentAdvector, in the order of kAdvectPhases (the first four make band
+    // growth, the next two sampling, the seventh renormalization): its wall time, and the
+    // time one thread worked in it while the others waited (levelset/parallel.h), what more
+    // cores cannot shorten.
     struct PhaseTime {
         double seconds = 0.0, serialSeconds = 0.0;
     };
