@@ -18,7 +18,9 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include "cli/command.h"
 #include "cli/progress.h"
+#include "cli/study_command.h"
 #include "core/memory.h"
 #include "io/atomic_file.h"
 #include "io/film_files.h"
@@ -34,40 +36,23 @@
 #include "sculpt/film.h"
 #include "sculpt/sculptor.h"
 
-namespace {
+namespace sweepers::cli {
 
-using namespace sweepers;
-using cli::ProgressLine;
-using cli::ProgressMode;
-using nlohmann::json;
-
-enum ExitCode : int { kDone = 0, kFailed = 1, kUsage = 2, kPartlyDone = 3, kInterrupted = 130 };
-
-// An option's value that makes no sense (a negative voxel size, a frame range that is not
-// one): a usage error, as CLI11's own are, not a refusal of the user's input files.
-struct UsageError : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
-
-// What every command shares: -q (nothing on stderr but errors) and --json (one JSON object
-// on stdout, for scripts that drive the command).
-struct Output {
-    bool quiet = false, json = false;
-    ProgressMode progress() const { return cli::progressModeFor(quiet); }
-    // A line for the user on stderr, unless -q.
-    void say(const std::string& line) const {
-        if (!quiet) std::fprintf(stderr, "%s\n", line.c_str());
-    }
-};
 Output gOut;
+FlagInterrupter gStop;
 
-void printJson(const json& j) {
+void printJson(const nlohmann::json& j) {
     std::cout << j.dump(2) << "\n";
 }
 
-// Ctrl-C (SIGINT) or SIGTERM stops long work at the next leaf range: the handler only sets
-// a flag, the engine throws Cancelled, and no output has been written yet.
-FlagInterrupter gStop;
+} // namespace sweepers::cli
+
+namespace {
+
+using namespace sweepers;
+using namespace sweepers::cli;
+using nlohmann::json;
+
 extern "C" void onStopSignal(int) {
     gStop.interrupt();
 }
@@ -458,194 +443,6 @@ int runRecover(const std::string& where, const std::string& output, const std::s
     return kDone;
 }
 
-struct StudyArgs {
-    std::string script, dir, voxelSizes = "1/32,1/64,1/128,1/256", variants = "trilinear";
-    bool force = false;
-};
-
-// "1/32,1/64,0.01": voxel sizes as decimals or 1/N, coarsest first.
-std::vector<double> parseVoxelSizes(const std::string& list) {
-    std::vector<double> sizes;
-    std::stringstream in(list);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-        const std::string bad =
-            "--voxel-sizes: '" + item + "' is not a voxel size (a decimal such as 0.02, or 1/N)";
-        const bool fraction = item.rfind("1/", 0) == 0;
-        const std::string digits = fraction ? item.substr(2) : item;
-        std::size_t used = 0;
-        double v = 0.0;
-        try {
-            v = std::stod(digits, &used);
-        } catch (const std::exception&) {
-            throw UsageError(bad);
-        }
-        if (used != digits.size() || !std::isfinite(v)) throw UsageError(bad);
-        if (v <= 0.0) throw UsageError("--voxel-sizes: '" + item + "' is not a positive size");
-        const double h = fraction ? 1.0 / v : v;
-        if (std::find(sizes.begin(), sizes.end(), h) != sizes.end())
-            throw UsageError("--voxel-sizes: '" + item + "' is given twice");
-        sizes.push_back(h);
-    }
-    if (sizes.empty()) throw UsageError("--voxel-sizes: no voxel size given");
-    std::sort(sizes.begin(), sizes.end(), std::greater<>());
-    return sizes;
-}
-
-std::vector<StudyVariant> parseVariants(const std::string& list) {
-    std::vector<StudyVariant> out;
-    std::stringstream in(list);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-        const auto v = parseVariant(item);
-        if (!v)
-            throw UsageError("--variants: unknown variant '" + item +
-                             "' (trilinear, cubic, per-substep, first-order)");
-        if (std::find(out.begin(), out.end(), *v) == out.end()) out.push_back(*v);
-    }
-    if (out.empty()) throw UsageError("--variants: no variant given");
-    return out;
-}
-
-// Applies a script at several voxel sizes and variants and measures every result against
-// the exact reference of its history. Each finished run is saved (its grid, mesh and row)
-// before the next starts, so an interrupted study resumes where it stopped.
-int runStudy(const StudyArgs& a) {
-    const std::vector<double> sizes = parseVoxelSizes(a.voxelSizes);
-    const std::vector<StudyVariant> variants = parseVariants(a.variants);
-    const StrokeScript script = readStrokeScript(a.script);
-    for (const double h : sizes)
-        requireBuildableStart(script, h, a.force); // the limits apply holds the script to
-    std::error_code ec;
-    std::filesystem::create_directories(a.dir, ec);
-    if (ec)
-        throw std::runtime_error(a.dir + ": cannot create the study directory (" + ec.message() +
-                                 ")");
-    const std::string csv = a.dir + "/study.csv", report = a.dir + "/report.md";
-    requireWritable(csv);
-    std::vector<StudyRow> earlier = readStudyCsv(csv);
-
-    std::vector<StudyRow> rows;
-    const std::size_t total = sizes.size() * variants.size();
-    std::size_t reused = 0;
-    json files = json::array();
-    // A line per finished run wherever stderr goes; the segments of the run in progress only
-    // as a bar on a terminal.
-    ProgressLine progress(gOut.progress(), "study", "run");
-    progress.setLinesEachTenth(false);
-    for (const double h : sizes)
-        for (const StudyVariant v : variants) {
-            StudyRow planned;
-            planned.variant = variantName(v);
-            planned.voxelSize = h;
-            const std::string name = studyRunName(planned);
-            const std::string vdbPath = a.dir + "/" + name + ".vdb";
-            const std::string plyPath = a.dir + "/" + name + ".ply";
-            const std::size_t k = rows.size() + 1;
-            const std::string which = "study: run " + std::to_string(k) + " / " +
-                                      std::to_string(total) + " (" + name + ")";
-            const auto done = std::find_if(earlier.begin(), earlier.end(), [&](const StudyRow& r) {
-                return r.variant == planned.variant && r.voxelSize == h && r.failure.empty();
-            });
-            if (done != earlier.end() && std::filesystem::exists(vdbPath)) {
-                rows.push_back(*done);
-                ++reused;
-                files.push_back(vdbPath);
-                files.push_back(plyPath);
-                progress.print(which + ": kept from before");
-                continue;
-            }
-            ProgressLine segments(progress.mode() == ProgressMode::Terminal ? ProgressMode::Terminal
-                                                                            : ProgressMode::Quiet,
-                                  which, "segment");
-            try {
-                const GridPtr start =
-                    makeStartGrid(script, directoryOf(a.script), h, &gStop, a.force);
-                const ExactReference::StartFunction shape =
-                    script.start.kind == StartShape::Kind::Sphere
-                        ? ExactReference::sphere(script.start.center, script.start.radius)
-                        : ExactReference::sampled(start->deepCopy());
-                StudyRun run =
-                    runStudyCase(start, script.strokes, shape, v, &gStop,
-                                 [&](std::size_t i, std::size_t n) { segments.update(i, n); });
-                AtomicWrite vdb = prepareLevelSet(*run.grid, vdbPath);
-                AtomicWrite mesh = prepareMesh(run.mesh, plyPath);
-                vdb.commit();
-                mesh.commit();
-                rows.push_back(run.row);
-                files.push_back(vdbPath);
-                files.push_back(plyPath);
-                segments.finish();
-                char line[96];
-                std::snprintf(line, sizeof line, ": done in %.2f s, RMS error %.3g voxels",
-                              run.row.wallSeconds, run.row.error.rms / h);
-                progress.print(which + line);
-            } catch (const Cancelled&) {
-                // The finished runs are on disk already: say so, rather than "nothing was
-                // written".
-                writeTextAtomically(csv, studyCsv(rows));
-                segments.finish();
-                std::fprintf(stderr,
-                             "sweepers-cli: interrupted after %zu of %zu runs; they are in %s "
-                             "(the same command resumes the study)\n",
-                             rows.size(), total, csv.c_str());
-                return kInterrupted;
-            } catch (const std::exception& e) {
-                // One failed run is reported in its row; the others still run.
-                planned.failure = e.what();
-                rows.push_back(planned);
-                segments.finish();
-                progress.print(which + ": failed: " + planned.failure);
-            }
-            fillOrders(rows);
-            writeTextAtomically(csv, studyCsv(rows));
-        }
-    fillOrders(rows);
-    writeTextAtomically(csv, studyCsv(rows));
-    writeTextAtomically(report, studyReport(rows, a.script));
-    std::size_t failed = 0;
-    json failedRuns = json::array();
-    for (const StudyRow& r : rows)
-        if (!r.failure.empty()) {
-            ++failed;
-            failedRuns.push_back(studyRunName(r));
-        }
-    gOut.say("wrote " + csv + " and " + report + ": " + std::to_string(rows.size()) + " runs (" +
-             std::to_string(reused) + " reused from before, " + std::to_string(failed) +
-             " failed)");
-    // The table stands without the plots: a plot that cannot be drawn is said, not fatal to it.
-    std::string plotsError;
-    try {
-        writeStudyPlots(rows, a.dir, a.script);
-        for (const char* f : {"convergence.gp", "convergence.png", "convergence.svg"})
-            files.push_back(a.dir + "/" + f);
-    } catch (const std::exception& e) {
-        plotsError = e.what();
-        std::fprintf(stderr, "sweepers-cli: %s\n", e.what());
-    }
-    if (failed > 0) {
-        std::string names;
-        for (const auto& n : failedRuns)
-            names += (names.empty() ? "" : ", ") + n.get<std::string>();
-        std::fprintf(stderr, "sweepers-cli: %zu of %zu runs failed (%s); see %s\n", failed,
-                     rows.size(), names.c_str(), report.c_str());
-    }
-    if (gOut.json) {
-        files.push_back(csv);
-        files.push_back(report);
-        printJson({{"script", a.script},
-                   {"dir", a.dir},
-                   {"csv", csv},
-                   {"report", report},
-                   {"runs", studyJson(rows)},
-                   {"reused", reused},
-                   {"failed", failedRuns},
-                   {"plots_error", plotsError.empty() ? json(nullptr) : json(plotsError)},
-                   {"files", files}});
-    }
-    return failed == 0 && plotsError.empty() ? kDone : kPartlyDone;
-}
-
 struct AnimateArgs {
     std::string script, output, mesh, frames, fog, up = "y";
     double fps = 24.0, secondsPerSegment = 0.25, voxelSize = 0.0;
@@ -872,19 +669,9 @@ static int run(int argc, char** argv) {
     recover->add_option("--script", scriptOut, "Also write the recovered stroke script (.json)");
 
     StudyArgs studyArgs;
-    CLI::App* study = app.add_subcommand(
-        "study", "Apply a script at several voxel sizes and variants, measured against the "
-                 "exact shape its history defines");
-    study->add_option("script", studyArgs.script, "Stroke script (JSON)")->required();
-    study->add_option("-o,--output", studyArgs.dir, "Study directory")->required();
-    study->add_option("--voxel-sizes", studyArgs.voxelSizes,
-                      "Voxel sizes, decimals or 1/N (default 1/32,1/64,1/128,1/256)");
-    study->add_option("--variants", studyArgs.variants,
-                      "trilinear, cubic, per-substep, first-order (default trilinear)");
+    studyArgs.threads = &threads;
+    CLI::App* study = addStudyCommand(app, studyArgs);
     jsonFlag(study, "every run's row and the files written");
-    study->add_flag("--force", studyArgs.force,
-                    "Build start shapes even when they seem to need more memory than is free");
-    study->add_option("--threads", threads, "Worker threads")->check(CLI::Range(1, 1024));
 
     AnimateArgs animateArgs;
     CLI::App* animate = app.add_subcommand(

@@ -839,12 +839,8 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
     return indent < 0 ? root.dump() : root.dump(indent) + "\n";
 }
 
-StrokeScript withAbsoluteFiles(StrokeScript s, const std::string& scriptDir) {
-    auto absolute = [&](std::string& file) {
-        if (!file.empty() && file.front() != '/')
-            file = std::filesystem::absolute(resolveAgainst(file, scriptDir)).string();
-    };
-    if (s.start.kind != StartShape::Kind::Sphere) absolute(s.start.file);
+void forEachScriptFile(StrokeScript& s, const std::function<void(std::string& file)>& visit) {
+    if (s.start.kind != StartShape::Kind::Sphere) visit(s.start.file);
     for (Stroke& stroke : s.strokes) {
         std::vector<ToolSpec*> tools;
         if (auto* sweep = std::get_if<SweepStroke>(&stroke))
@@ -856,10 +852,17 @@ StrokeScript withAbsoluteFiles(StrokeScript s, const std::string& scriptDir) {
         if (auto* keyed = std::get_if<KeyframedStroke>(&stroke)) tools.push_back(&keyed->tool);
         if (auto* flow = std::get_if<FlowStroke>(&stroke);
             flow && flow->field.kind == FieldSpec::Kind::Sampled)
-            absolute(flow->field.file);
+            visit(flow->field.file);
         for (ToolSpec* t : tools)
-            if (t->shape == ToolShapeKind::Baked) absolute(t->source.file);
+            if (t->shape == ToolShapeKind::Baked) visit(t->source.file);
     }
+}
+
+StrokeScript withAbsoluteFiles(StrokeScript s, const std::string& scriptDir) {
+    forEachScriptFile(s, [&](std::string& file) {
+        if (!file.empty() && file.front() != '/')
+            file = std::filesystem::absolute(resolveAgainst(file, scriptDir)).string();
+    });
     return s;
 }
 

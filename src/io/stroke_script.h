@@ -21,6 +21,7 @@
 // refused too: in a hand-written script they are nearly always typos.
 #pragma once
 
+#include <functional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -50,6 +51,9 @@ std::vector<std::string> strokeScriptFields();
 // Serialize (numbers round-trip exactly): pretty-printed with `indent` spaces and a final
 // line break, or on one line without a line break when indent < 0.
 std::string formatStrokeScript(const StrokeScript& script, int indent = 2);
+// Calls `visit` with every file name the script refers to (its start, baked tools and
+// sampled velocity fields, as written in it), which it may change.
+void forEachScriptFile(StrokeScript& script, const std::function<void(std::string& file)>& visit);
 // The same script with its start and tool files named absolutely (relative names are taken
 // from `scriptDir`), so that it works wherever it is saved.
 StrokeScript withAbsoluteFiles(StrokeScript script, const std::string& scriptDir);

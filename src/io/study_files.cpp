@@ -21,13 +21,38 @@ namespace sweepers {
 
 namespace {
 
-const char* const kColumns[] = {
-    "variant",        "voxel_size",  "wall_s",         "advect_s",   "renorm_s",
-    "mesh_s",         "peak_rss_mb", "active_voxels",  "volume",     "volume_change_pct",
-    "area",           "euler",       "genus",          "components", "err_mean",
-    "err_rms",        "err_max",     "err_rms_voxels", "sign_flips", "order_rms",
-    "volume_ref",     "volume_err",  "order_volume",   "ref_euler",  "ref_genus",
-    "ref_components", "err_samples", "unmatched",      "failure"};
+const char* const kColumns[] = {"script",
+                                "variant",
+                                "voxel_size",
+                                "wall_s",
+                                "advect_s",
+                                "renorm_s",
+                                "mesh_s",
+                                "peak_rss_mb",
+                                "active_voxels",
+                                "volume",
+                                "volume_change_pct",
+                                "area",
+                                "euler",
+                                "genus",
+                                "components",
+                                "err_mean",
+                                "err_rms",
+                                "err_max",
+                                "err_rms_voxels",
+                                "sign_flips",
+                                "order_rms",
+                                "volume_ref",
+                                "volume_err",
+                                "order_volume",
+                                "ref_euler",
+                                "ref_genus",
+                                "ref_components",
+                                "err_samples",
+                                "unmatched",
+                                "threads",
+                                "host",
+                                "failure"};
 constexpr std::size_t kColumnCount = sizeof(kColumns) / sizeof(kColumns[0]);
 // The position of a column in kColumns.
 std::size_t column(std::string_view name) {
@@ -55,31 +80,6 @@ std::string field(const std::string& s) {
         out += c == '\n' || c == '\r' ? ' ' : c;
     }
     return out + "\"";
-}
-
-std::vector<std::string> splitCsvLine(const std::string& line) {
-    std::vector<std::string> out(1);
-    bool quoted = false;
-    for (std::size_t i = 0; i < line.size(); ++i) {
-        const char c = line[i];
-        if (quoted) {
-            if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-                out.back() += '"';
-                ++i;
-            } else if (c == '"') {
-                quoted = false;
-            } else {
-                out.back() += c;
-            }
-        } else if (c == '"') {
-            quoted = true;
-        } else if (c == ',') {
-            out.emplace_back();
-        } else {
-            out.back() += c;
-        }
-    }
-    return out;
 }
 
 double toNumber(const std::string& s, const std::string& where) {
@@ -189,70 +189,94 @@ std::string runGnuplot(const std::string& dir, const std::string& script,
 
 } // namespace
 
-void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir,
-                     const std::string& script) {
-    // One data block per variant (gnuplot breaks a line at every row it skips, and the table
-    // interleaves the variants): voxel size, RMS error, volume error (percent of the exact
-    // volume), time, peak memory.
-    std::vector<std::string> variants;
-    std::set<double> sizes;
-    std::ostringstream blocks;
-    const StudyRow* first = nullptr;
-    for (const StudyRow& r : rows)
-        if (r.failure.empty() &&
-            std::find(variants.begin(), variants.end(), r.variant) == variants.end())
-            variants.push_back(r.variant);
-    for (std::size_t v = 0; v < variants.size(); ++v) {
-        blocks << "$v" << v << " << EOD\n";
-        for (const StudyRow& r : rows) {
-            if (!r.failure.empty() || r.variant != variants[v]) continue;
-            if (!first) first = &r;
-            sizes.insert(r.voxelSize);
-            blocks << number(r.voxelSize, 17) << " " << number(r.error.rms) << " "
-                   << number(100.0 * r.error.volumeError() / r.error.referenceVolume) << " "
-                   << number(r.wallSeconds) << " " << number(r.peakRssMb) << "\n";
+void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir) {
+    // Per script, one data block per variant (gnuplot breaks a line at every row it skips,
+    // and the table interleaves the variants): voxel size, RMS error, volume error (percent
+    // of the exact volume), time, peak memory. Then a set of four panels per script.
+    const std::vector<std::string> scripts = studyScripts(rows);
+    std::ostringstream blocks, panels;
+    std::size_t drawn = 0;
+    for (std::size_t s = 0; s < scripts.size(); ++s) {
+        std::vector<std::string> variants;
+        std::set<double> sizes;
+        const StudyRow* first = nullptr;
+        for (const StudyRow& r : rows)
+            if (r.script == scripts[s] && r.failure.empty() &&
+                std::find(variants.begin(), variants.end(), r.variant) == variants.end())
+                variants.push_back(r.variant);
+        const auto block = [&](std::size_t v) {
+            return "$s" + std::to_string(s) + "v" + std::to_string(v);
+        };
+        for (std::size_t v = 0; v < variants.size(); ++v) {
+            blocks << block(v) << " << EOD\n";
+            for (const StudyRow& r : rows) {
+                if (r.script != scripts[s] || !r.failure.empty() || r.variant != variants[v])
+                    continue;
+                if (!first) first = &r;
+                sizes.insert(r.voxelSize);
+                blocks << number(r.voxelSize, 17) << " " << number(r.error.rms) << " "
+                       << number(100.0 * r.error.volumeError() / r.error.referenceVolume) << " "
+                       << number(r.wallSeconds) << " " << number(r.peakRssMb) << "\n";
+            }
+            blocks << "EOD\n";
         }
-        blocks << "EOD\n";
+        if (!first) {
+            // Four empty panels keep the layout: the script's runs all failed.
+            panels << "set multiplot next\nset multiplot next\nset multiplot next\n"
+                      "set multiplot next\n";
+            continue;
+        }
+        ++drawn;
+        // Guides through the first run's error: e = a h and e = b h^2.
+        const double h0 = first->voxelSize, e0 = std::max(first->error.rms, 1e-300);
+        std::string tics;
+        for (const double h : sizes)
+            tics += (tics.empty() ? "" : ", ") + quoted("1/" + number(1.0 / h, 6)) + " " +
+                    number(h, 17);
+        const auto series = [&](int column) {
+            std::ostringstream p;
+            p << "plot ";
+            for (std::size_t v = 0; v < variants.size(); ++v)
+                p << (v ? ", " : "") << block(v) << " using 1:" << column
+                  << " with linespoints pointtype 7 linecolor " << v + 1 << " title "
+                  << quoted(variants[v]);
+            return p.str();
+        };
+        const std::string of = scripts.size() > 1 ? " (" + scripts[s] + ")" : "";
+        panels << "set xtics (" << tics << ")\n"
+               << "set key bottom right\nset logscale y\n"
+               << "set ylabel 'RMS distance to the exact surface'\n"
+               << "set title " << quoted("interface error" + of) << "\n"
+               << series(2) << ", " << number(e0 / h0, 17) << " * x dashtype 2 linecolor 'gray' "
+               << "title 'slope 1', " << number(e0 / (h0 * h0), 17)
+               << " * x**2 dashtype 3 linecolor 'black' title 'slope 2'\n"
+               << "unset key\nunset logscale y\nset ylabel 'volume error (%)'\n"
+               << "set title " << quoted("volume drift from the exact shape" + of)
+               << "\nset xzeroaxis\n"
+               << series(3) << "\n"
+               << "unset xzeroaxis\nset logscale y\nset ylabel 'seconds'\n"
+               << "set title " << quoted("time" + of) << "\n"
+               << series(4) << "\n"
+               << "set ylabel 'MB'\nset title " << quoted("peak resident memory of each run" + of)
+               << "\n"
+               << series(5) << "\n";
     }
-    if (!first) throw std::runtime_error("plots: no run finished, nothing to draw");
-    // Guides through the first run's error: e = a h and e = b h^2.
-    const double h0 = first->voxelSize, e0 = std::max(first->error.rms, 1e-300);
-    std::string tics;
-    for (const double h : sizes)
-        tics +=
-            (tics.empty() ? "" : ", ") + quoted("1/" + number(1.0 / h, 6)) + " " + number(h, 17);
-    const auto series = [&](int column) {
-        std::ostringstream p;
-        p << "plot ";
-        for (std::size_t v = 0; v < variants.size(); ++v)
-            p << (v ? ", " : "") << "$v" << v << " using 1:" << column
-              << " with linespoints pointtype 7 linecolor " << v + 1 << " title "
-              << quoted(variants[v]);
-        return p.str();
-    };
+    if (drawn == 0) throw std::runtime_error("plots: no run finished, nothing to draw");
+    const std::string height = std::to_string(960 * scripts.size());
+    const std::string title =
+        "Grid-resolution study" + (scripts.size() == 1 ? " of " + scripts.front() : "");
     std::ostringstream gp;
     gp << "# Drawn by sweepers-cli study; to draw it again:\n"
-       << "#   gnuplot -e 'set terminal pngcairo size 1280,960' convergence.gp > convergence.png\n"
-       << blocks.str() << "set multiplot layout 2,2 title "
-       << quoted("Grid-resolution study of " + script) << " noenhanced\n"
-       << "set grid\nset logscale x\nset xtics (" << tics << ")\nset xlabel 'voxel size'\n"
-       << "set format y '%g'\nset key bottom right\n"
-       << "set logscale y\nset ylabel 'RMS distance to the exact surface'\n"
-       << "set title 'interface error'\n"
-       << series(2) << ", " << number(e0 / h0, 17) << " * x dashtype 2 linecolor 'gray' "
-       << "title 'slope 1', " << number(e0 / (h0 * h0), 17)
-       << " * x**2 dashtype 3 linecolor 'black' title 'slope 2'\n"
-       << "unset key\nunset logscale y\nset ylabel 'volume error (%)'\n"
-       << "set title 'volume drift from the exact shape'\nset xzeroaxis\n"
-       << series(3) << "\n"
-       << "unset xzeroaxis\nset logscale y\nset ylabel 'seconds'\nset title 'time'\n"
-       << series(4) << "\n"
-       << "set ylabel 'MB'\nset title 'peak resident memory during each run'\n"
-       << series(5) << "\n"
-       << "unset multiplot\n";
+       << "#   gnuplot -e 'set terminal pngcairo size 1280," << height
+       << "' convergence.gp > convergence.png\n"
+       << blocks.str() << "set termoption noenhanced\nset multiplot layout " << 2 * scripts.size()
+       << ",2 title " << quoted(title) << " noenhanced\n"
+       << "set grid\nset logscale x\nset xlabel 'voxel size'\nset format y '%g'\n"
+       << panels.str() << "unset multiplot\n";
     writeTextAtomically(dir + "/convergence.gp", gp.str());
-    const std::string png = runGnuplot(dir, "convergence.gp", "pngcairo size 1280,960");
-    const std::string svg = runGnuplot(dir, "convergence.gp", "svg size 1280,960");
+    const std::string size = "size 1280," + height;
+    const std::string png = runGnuplot(dir, "convergence.gp", "pngcairo " + size);
+    const std::string svg = runGnuplot(dir, "convergence.gp", "svg " + size);
     writeTextAtomically(dir + "/convergence.png", png);
     writeTextAtomically(dir + "/convergence.svg", svg);
 }
@@ -263,20 +287,28 @@ std::string studyRunName(const StudyRow& row) {
     return row.variant + "_" + number(row.voxelSize, 12);
 }
 
+std::string studyRunId(const StudyRow& row) {
+    return row.script + "-" + studyRunName(row);
+}
+
 namespace {
 
-// A row's cells in kColumns' order, as the table writes them: a failed run has only its
-// variant, voxel size and failure.
-std::vector<std::string> studyCells(const StudyRow& r) {
+// A row's cells in kColumns' order, as the table writes them (or with every digit a double
+// holds, for a run's result file that the table is made from later): a failed run has only
+// its script, variant, voxel size, where it ran and its failure.
+std::vector<std::string> studyCells(const StudyRow& r, bool allDigits) {
     const bool ran = r.failure.empty();
-    const auto num = [&](double v, int digits = 7) { return ran ? number(v, digits) : ""; };
+    const auto num = [&](double v, int digits = 7) {
+        return ran ? number(v, allDigits ? 17 : digits) : "";
+    };
     const auto count = [&](std::size_t v) { return ran ? std::to_string(v) : ""; };
     const auto integer = [&](int v) { return ran ? std::to_string(v) : ""; };
     // The exact topology's columns stay empty where it is not known.
     const auto known = [&](const std::string& v) {
         return r.referenceTopologyKnown ? v : std::string();
     };
-    return {r.variant,
+    return {r.script,
+            r.variant,
             number(r.voxelSize, 17),
             num(r.wallSeconds),
             num(r.advectSeconds),
@@ -304,7 +336,61 @@ std::vector<std::string> studyCells(const StudyRow& r) {
             known(count(r.referenceComponents)),
             count(r.error.samples),
             count(r.error.unmatched),
+            r.threads > 0 ? std::to_string(r.threads) : "",
+            r.host,
             r.failure};
+}
+
+bool isTextColumn(std::string_view name) {
+    return name == "script" || name == "variant" || name == "host" || name == "failure";
+}
+
+// A row from its cells in kColumns' order; `where` names them in a refusal.
+StudyRow studyRowFromCells(const std::vector<std::string>& f, const std::string& where) {
+    const auto at = [&](std::string_view name) -> const std::string& { return f[column(name)]; };
+    const auto real = [&](std::string_view name) { return toNumber(at(name), where); };
+    const auto whole = [&](std::string_view name, double lo, double hi) {
+        return wholeNumber(at(name), where, lo, hi);
+    };
+    StudyRow r;
+    r.script = at("script");
+    r.variant = at("variant");
+    r.voxelSize = real("voxel_size");
+    if (!(r.voxelSize > 0.0) || !std::isfinite(r.voxelSize))
+        throw FileError(where + ": '" + at("voxel_size") + "' is not a voxel size");
+    r.host = at("host");
+    if (!at("threads").empty()) r.threads = int(whole("threads", 1, kMaxTopology));
+    r.failure = at("failure");
+    if (!r.failure.empty()) return r;
+    r.wallSeconds = real("wall_s");
+    r.advectSeconds = real("advect_s");
+    r.renormSeconds = real("renorm_s");
+    r.meshSeconds = real("mesh_s");
+    r.peakRssMb = real("peak_rss_mb");
+    r.activeVoxels = std::size_t(whole("active_voxels", 0, kMaxCount));
+    r.volume = real("volume");
+    r.volumeChangePct = real("volume_change_pct");
+    r.area = real("area");
+    r.euler = int(whole("euler", -kMaxTopology, kMaxTopology));
+    r.genus = int(whole("genus", -kMaxTopology, kMaxTopology));
+    r.components = std::size_t(whole("components", 0, kMaxCount));
+    r.error.mean = real("err_mean");
+    r.error.rms = real("err_rms");
+    r.error.max = real("err_max");
+    r.error.signFlips = std::size_t(whole("sign_flips", 0, kMaxCount));
+    r.orderRms = real("order_rms");
+    r.error.referenceVolume = real("volume_ref");
+    r.error.meshVolume = r.error.referenceVolume + real("volume_err");
+    r.orderVolume = real("order_volume");
+    r.referenceTopologyKnown = !at("ref_euler").empty();
+    if (r.referenceTopologyKnown) {
+        r.referenceEuler = int(whole("ref_euler", -kMaxTopology, kMaxTopology));
+        r.referenceGenus = int(whole("ref_genus", -kMaxTopology, kMaxTopology));
+        r.referenceComponents = std::size_t(whole("ref_components", 0, kMaxCount));
+    }
+    r.error.samples = std::size_t(whole("err_samples", 0, kMaxCount));
+    r.error.unmatched = std::size_t(whole("unmatched", 0, kMaxCount));
+    return r;
 }
 
 } // namespace
@@ -315,7 +401,7 @@ std::string studyCsv(const std::vector<StudyRow>& rows) {
         out << (c ? "," : "") << kColumns[c];
     out << "\n";
     for (const StudyRow& r : rows) {
-        const std::vector<std::string> cells = studyCells(r);
+        const std::vector<std::string> cells = studyCells(r, false);
         for (std::size_t c = 0; c < kColumnCount; ++c)
             out << (c ? "," : "") << field(cells[c]);
         out << "\n";
@@ -323,97 +409,55 @@ std::string studyCsv(const std::vector<StudyRow>& rows) {
     return out.str();
 }
 
+nlohmann::json studyRowJson(const StudyRow& r, bool allDigits) {
+    const std::vector<std::string> cells = studyCells(r, allDigits);
+    nlohmann::json row = nlohmann::json::object();
+    for (std::size_t c = 0; c < kColumnCount; ++c) {
+        const std::string& cell = cells[c];
+        if (isTextColumn(kColumns[c]))
+            row[kColumns[c]] = cell;
+        else if (cell.empty() || cell == "nan")
+            row[kColumns[c]] = nullptr; // not measured, or no coarser run to compare
+        else if (cell.find_first_of(".eEn") == std::string::npos)
+            row[kColumns[c]] = std::stoll(cell); // counts and topology stay whole
+        else
+            row[kColumns[c]] = std::stod(cell);
+    }
+    return row;
+}
+
 nlohmann::json studyJson(const std::vector<StudyRow>& rows) {
     nlohmann::json out = nlohmann::json::array();
-    for (const StudyRow& r : rows) {
-        const std::vector<std::string> cells = studyCells(r);
-        nlohmann::json row = nlohmann::json::object();
-        for (std::size_t c = 0; c < kColumnCount; ++c) {
-            const std::string& cell = cells[c];
-            const std::string_view name = kColumns[c];
-            if (name == "variant" || name == "failure")
-                row[kColumns[c]] = cell;
-            else if (cell.empty() || cell == "nan")
-                row[kColumns[c]] = nullptr; // not measured, or no coarser run to compare
-            else if (cell.find_first_of(".eEn") == std::string::npos)
-                row[kColumns[c]] = std::stoll(cell); // counts and topology stay whole
-            else
-                row[kColumns[c]] = std::stod(cell);
-        }
-        out.push_back(std::move(row));
-    }
+    for (const StudyRow& r : rows)
+        out.push_back(studyRowJson(r, false));
     return out;
 }
 
-std::vector<StudyRow> readStudyCsv(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) return {};
-    std::string line;
-    if (!std::getline(in, line) || splitCsvLine(line).empty() ||
-        splitCsvLine(line)[0] != kColumns[0])
-        throw FileError(path + ": not a study table (its first line is not the header)");
-    if (splitCsvLine(line) != std::vector<std::string>(kColumns, kColumns + kColumnCount))
-        throw FileError(path + ": a study table with other columns (of another version of "
-                               "sweepers-cli); --force starts the study again");
-    std::vector<StudyRow> rows;
-    for (int n = 2; std::getline(in, line); ++n) {
-        if (line.empty()) continue;
-        const std::vector<std::string> f = splitCsvLine(line);
-        const std::string where = path + ", line " + std::to_string(n);
-        if (f.size() != kColumnCount)
-            throw FileError(where + ": " + std::to_string(f.size()) + " fields, not " +
-                            std::to_string(kColumnCount));
-        const auto at = [&](std::string_view name) -> const std::string& {
-            return f[column(name)];
-        };
-        const auto real = [&](std::string_view name) { return toNumber(at(name), where); };
-        const auto whole = [&](std::string_view name, double lo, double hi) {
-            return wholeNumber(at(name), where, lo, hi);
-        };
-        StudyRow r;
-        r.variant = at("variant");
-        r.voxelSize = real("voxel_size");
-        if (!(r.voxelSize > 0.0) || !std::isfinite(r.voxelSize))
-            throw FileError(where + ": '" + at("voxel_size") + "' is not a voxel size");
-        r.failure = at("failure");
-        if (!r.failure.empty()) {
-            rows.push_back(r);
-            continue;
-        }
-        r.wallSeconds = real("wall_s");
-        r.advectSeconds = real("advect_s");
-        r.renormSeconds = real("renorm_s");
-        r.meshSeconds = real("mesh_s");
-        r.peakRssMb = real("peak_rss_mb");
-        r.activeVoxels = std::size_t(whole("active_voxels", 0, kMaxCount));
-        r.volume = real("volume");
-        r.volumeChangePct = real("volume_change_pct");
-        r.area = real("area");
-        r.euler = int(whole("euler", -kMaxTopology, kMaxTopology));
-        r.genus = int(whole("genus", -kMaxTopology, kMaxTopology));
-        r.components = std::size_t(whole("components", 0, kMaxCount));
-        r.error.mean = real("err_mean");
-        r.error.rms = real("err_rms");
-        r.error.max = real("err_max");
-        r.error.signFlips = std::size_t(whole("sign_flips", 0, kMaxCount));
-        r.orderRms = real("order_rms");
-        r.error.referenceVolume = real("volume_ref");
-        r.error.meshVolume = r.error.referenceVolume + real("volume_err");
-        r.orderVolume = real("order_volume");
-        r.referenceTopologyKnown = !at("ref_euler").empty();
-        if (r.referenceTopologyKnown) {
-            r.referenceEuler = int(whole("ref_euler", -kMaxTopology, kMaxTopology));
-            r.referenceGenus = int(whole("ref_genus", -kMaxTopology, kMaxTopology));
-            r.referenceComponents = std::size_t(whole("ref_components", 0, kMaxCount));
-        }
-        r.error.samples = std::size_t(whole("err_samples", 0, kMaxCount));
-        r.error.unmatched = std::size_t(whole("unmatched", 0, kMaxCount));
-        rows.push_back(r);
+StudyRow studyRowFromJson(const nlohmann::json& j, const std::string& where) {
+    if (!j.is_object()) throw FileError(where + ": a study row is not a JSON object");
+    std::vector<std::string> cells(kColumnCount);
+    for (std::size_t c = 0; c < kColumnCount; ++c) {
+        const auto it = j.find(kColumns[c]);
+        if (it == j.end())
+            throw FileError(where + ": the row has no '" + std::string(kColumns[c]) + "'");
+        if (it->is_string() && isTextColumn(kColumns[c]))
+            cells[c] = it->get<std::string>();
+        else if (it->is_number_integer())
+            cells[c] = std::to_string(it->get<long long>());
+        else if (it->is_number())
+            cells[c] = number(it->get<double>(), 17);
+        else if (!it->is_null())
+            throw FileError(where + ": '" + std::string(kColumns[c]) + "' is " + it->dump());
+        else if (std::string_view(kColumns[c]).rfind("order_", 0) == 0 &&
+                 j.value("failure", "") == "")
+            cells[c] = "nan"; // no coarser run to compare with
     }
-    return rows;
+    return studyRowFromCells(cells, where);
 }
 
-std::string studyReport(const std::vector<StudyRow>& rows, const std::string& script) {
+namespace {
+
+std::string tableOf(const std::vector<StudyRow>& rows) {
     const auto changed = [](const StudyRow& r) {
         return r.referenceTopologyKnown &&
                (r.euler != r.referenceEuler || r.genus != r.referenceGenus ||
@@ -425,22 +469,7 @@ std::string studyReport(const std::vector<StudyRow>& rows, const std::string& sc
                (r.referenceComponents == 1 ? " component" : " components");
     };
     std::ostringstream out;
-    out << "# Grid-resolution study of " << script << "\n\n"
-        << "Errors are distances between the result's surface and the exact surface that the "
-           "history of inverses defines (both ways: mesh vertices to the exact surface along "
-           "their normals, exact crossings on voxel edges to the grid's surface); sign flips "
-           "are active voxels on the wrong side of the exact surface. The order p compares "
-           "each run with the next coarser one of its variant: "
-           "p = log(e_coarse / e_fine) / log(h_coarse / h_fine). The volume error is the signed "
-           "volume between the result's mesh and the same mesh with every vertex moved to the "
-           "exact surface, in percent of the latter (the exact volume on the result's "
-           "tessellation); its order is that of its size. The exact shape keeps the start's "
-           "topology, since every sub-step is a fold-over-free deformation of space; where a "
-           "run's topology differs, the grid lost a feature thinner than it resolves, and "
-           "its components column gives the exact topology. A pinch or a strangle tears space "
-           "on purpose, and the exact topology of a history that holds one is not known here: "
-           "no run of it is marked.\n\n"
-        << "| variant | voxel size | err RMS (voxels) | err max (voxels) | err RMS | order (RMS) "
+    out << "| variant | voxel size | err RMS (voxels) | err max (voxels) | err RMS | order (RMS) "
            "| sign flips | volume error | order (volume) | volume change | Euler | genus "
            "| components | time (s) |\n"
         << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
@@ -459,6 +488,64 @@ std::string studyReport(const std::vector<StudyRow>& rows, const std::string& sc
             << r.components << (changed(r) ? " (exact: " + topology(r) + ")" : "") << " | "
             << number(r.wallSeconds, 3) << " |\n";
     }
+    return out.str();
+}
+
+} // namespace
+
+std::vector<std::string> studyScripts(const std::vector<StudyRow>& rows) {
+    std::vector<std::string> scripts;
+    for (const StudyRow& r : rows)
+        if (std::find(scripts.begin(), scripts.end(), r.script) == scripts.end())
+            scripts.push_back(r.script);
+    return scripts;
+}
+
+std::string studyReport(const std::vector<StudyRow>& rows, const std::vector<StudyRow>& missing) {
+    std::ostringstream out;
+    const std::vector<std::string> scripts = studyScripts(rows);
+    out << "# Grid-resolution study";
+    if (scripts.size() == 1) out << " of " << scripts.front();
+    out << "\n\n"
+        << "Errors are distances between the result's surface and the exact surface that the "
+           "history of inverses defines (both ways: mesh vertices to the exact surface along "
+           "their normals, exact crossings on voxel edges to the grid's surface); sign flips "
+           "are active voxels on the wrong side of the exact surface. The order p compares "
+           "each run with the next coarser one of its variant: "
+           "p = log(e_coarse / e_fine) / log(h_coarse / h_fine). The volume error is the signed "
+           "volume between the result's mesh and the same mesh with every vertex moved to the "
+           "exact surface, in percent of the latter (the exact volume on the result's "
+           "tessellation); its order is that of its size. The exact shape keeps the start's "
+           "topology, since every sub-step is a fold-over-free deformation of space; where a "
+           "run's topology differs, the grid lost a feature thinner than it resolves, and "
+           "its components column gives the exact topology. A pinch or a strangle tears space "
+           "on purpose, and the exact topology of a history that holds one is not known here: "
+           "no run of it is marked.\n\n";
+    for (const std::string& script : scripts) {
+        std::vector<StudyRow> own;
+        for (const StudyRow& r : rows)
+            if (r.script == script) own.push_back(r);
+        if (scripts.size() > 1) out << "## " << script << "\n\n";
+        out << tableOf(own) << "\n";
+    }
+    if (!missing.empty()) {
+        out << "## Runs without a result\n\n"
+               "These runs have not finished: they were not run yet, were cancelled or stopped, "
+               "or their process ended without writing a result (see the run's log). Running "
+               "the study again runs them.\n\n";
+        for (const StudyRow& r : missing)
+            out << "- " << studyRunId(r) << "\n";
+        out << "\n";
+    }
+    out << "## Where each run ran\n\n"
+        << "| run | host | threads | time (s) | peak memory (MB) | result |\n"
+        << "|---|---|---|---|---|---|\n";
+    for (const StudyRow& r : rows)
+        out << "| " << studyRunId(r) << " | " << r.host << " | "
+            << (r.threads > 0 ? std::to_string(r.threads) : "") << " | "
+            << (r.failure.empty() ? number(r.wallSeconds, 3) : "") << " | "
+            << (r.failure.empty() ? number(r.peakRssMb, 4) : "") << " | "
+            << (r.failure.empty() ? "done" : "failed") << " |\n";
     return out.str();
 }
 

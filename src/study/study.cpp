@@ -226,10 +226,10 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
 }
 
 void fillOrders(std::vector<StudyRow>& rows) {
-    std::map<std::string, std::vector<StudyRow*>> byVariant;
+    std::map<std::pair<std::string, std::string>, std::vector<StudyRow*>> byVariant;
     for (StudyRow& r : rows) {
         r.orderRms = r.orderVolume = std::numeric_limits<double>::quiet_NaN();
-        if (r.failure.empty()) byVariant[r.variant].push_back(&r);
+        if (r.failure.empty()) byVariant[{r.script, r.variant}].push_back(&r);
     }
     // p = log(e_coarse / e_fine) / log(h_coarse / h_fine)
     const auto order = [](double coarseError, double fineError, double coarseH, double fineH) {

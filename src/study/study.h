@@ -49,6 +49,7 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
                               const ExactReference& reference, Interrupter* interrupter = nullptr);
 
 struct StudyRow {
+    std::string script; // the script's name in a study of several (its file's stem)
     std::string variant;
     double voxelSize = 0.0;
     double wallSeconds = 0.0, advectSeconds = 0.0, renormSeconds = 0.0, meshSeconds = 0.0;
@@ -74,6 +75,9 @@ struct StudyRow {
     // The same for the size of the volume error, |error.volumeError()|.
     double orderVolume = std::numeric_limits<double>::quiet_NaN();
     std::string failure; // why the run failed; empty when it ran
+    // Where the run ran: the machine's name and the worker threads it had.
+    std::string host;
+    int threads = 0;
 };
 
 // A run's result: the sculpted grid, its welded mesh and its row.
@@ -90,8 +94,8 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
                       const ExactReference::StartFunction& startShape, StudyVariant variant,
                       Interrupter* interrupter = nullptr, const Progress& progress = {});
 
-// Fills orderRms and orderVolume of every row from the next coarser row of its variant
-// (failed rows and rows without a coarser one get NaN).
+// Fills orderRms and orderVolume of every row from the next coarser row of its script and
+// variant (failed rows and rows without a coarser one get NaN).
 void fillOrders(std::vector<StudyRow>& rows);
 
 } // namespace sweepers

@@ -153,9 +153,9 @@ JSON
 rc=0
 "$cli" study "$tmp/own.json" -o "$tmp/partly" --voxel-sizes 0.125,0.0625 2>"$tmp/partly.err" || rc=$?
 [ "$rc" = 3 ] || fail "a study with a failed run exited $rc: $(cat "$tmp/partly.err")"
-grep -q 'sweepers-cli: 1 of 2 runs failed (trilinear_8)' "$tmp/partly.err" ||
+grep -q 'sweepers-cli: 1 of 2 runs failed (own-trilinear_8)' "$tmp/partly.err" ||
   fail "the failed run is not named: $(cat "$tmp/partly.err")"
-[ -s "$tmp/partly/trilinear_16.vdb" ] || fail "the run that could run was not written"
+[ -s "$tmp/partly/runs/own-trilinear_16/grid.vdb" ] || fail "the run that could run was not written"
 grep -q '| trilinear | 1/8 | failed: ' "$tmp/partly/report.md" ||
   fail "report.md does not name the failed run"
 echo "exit codes: 0, 1, 2, 3 (a study with a failed run) and 130 (SIGINT)"

@@ -19,19 +19,20 @@ EOF
 import csv, math, struct, sys
 d = sys.argv[1]
 rows = list(csv.DictReader(open(f"{d}/study.csv")))
-columns = ("variant voxel_size wall_s advect_s renorm_s mesh_s peak_rss_mb active_voxels volume "
+columns = ("script variant voxel_size wall_s advect_s renorm_s mesh_s peak_rss_mb active_voxels volume "
            "volume_change_pct area euler genus components err_mean err_rms err_max "
-           "err_rms_voxels sign_flips order_rms volume_ref volume_err order_volume").split()
+           "err_rms_voxels sign_flips order_rms volume_ref volume_err order_volume threads host").split()
 missing = [c for c in columns if c not in rows[0]]
 assert not missing, f"columns missing: {missing}"
 assert [(r["variant"], float(r["voxel_size"])) for r in rows] == [
     ("trilinear", 1 / 32), ("first-order", 1 / 32), ("trilinear", 1 / 64),
     ("first-order", 1 / 64)], rows
 for r in rows:
+    assert r["script"] == "translate" and int(r["threads"]) >= 1 and r["host"], r
     assert r["failure"] == "" and int(r["euler"]) == 2 and int(r["components"]) == 1, r
 # Independently: the distance of every vertex of the exported mesh to the moved sphere
 # (a binary PLY whose vertices are float properties, x y z first).
-data = open(f"{d}/trilinear_64.ply", "rb").read()
+data = open(f"{d}/runs/translate-trilinear_64/mesh.ply", "rb").read()
 header, body = data.split(b"end_header\n", 1)
 lines = header.decode().splitlines()
 start = next(i for i, l in enumerate(lines) if l.startswith("element vertex"))
@@ -85,7 +86,7 @@ import csv, sys
 d = sys.argv[1]
 rows = [r for r in csv.DictReader(open(f"{d}/study.csv")) if r["variant"] == "trilinear"]
 gp = open(f"{d}/convergence.gp").read()
-block = gp.split("$v0 << EOD\n", 1)[1].split("EOD\n", 1)[0].split("\n")[:-1]
+block = gp.split("$s0v0 << EOD\n", 1)[1].split("EOD\n", 1)[0].split("\n")[:-1]
 assert len(block) == len(rows), (block, rows)
 for line, r in zip(block, rows):
     h, rms, volume = map(float, line.split()[:3])
@@ -139,12 +140,68 @@ assert sum(1 for e in root.iter() if e.tag.endswith("path")) > 10
 print("plots: convergence.png 1280x960 and a valid convergence.svg")
 PY
 
+# --- several scripts; --jobs 2 gives the table of one run at a time ---------------------
+two=("$data/studies/rigid_motion.json" "$tmp/translate.json")
+sizes=(--voxel-sizes 1/16,1/32 --variants trilinear,cubic)
+"$cli" study "${two[@]}" -o "$tmp/jobs1" "${sizes[@]}" -q
+"$cli" study "${two[@]}" -o "$tmp/jobs2" "${sizes[@]}" --jobs 2 -q
+"$py" "$(dirname "$0")/same_table.py" "$tmp/jobs1/study.csv" "$tmp/jobs2/study.csv"
+"$py" - "$tmp/jobs2" <<'PY'
+import csv, json, sys
+from PIL import Image
+d = sys.argv[1]
+rows = list(csv.DictReader(open(f"{d}/study.csv")))
+assert [r["script"] for r in rows] == ["rigid_motion"] * 4 + ["translate"] * 4, rows
+# Each run had half the threads, in a process of its own.
+assert {r["threads"] for r in rows} == {str(max(1, int(rows[0]["threads"])))}, rows
+plan = json.load(open(f"{d}/plan.json"))
+assert [r["id"] for r in plan["runs"]][:2] == ["rigid_motion-trilinear_16", "rigid_motion-cubic_16"]
+# Before any run finished, only the memory of a sphere's band is estimated: more at half
+# the voxel size.
+est = {r["id"]: r["estimate"] for r in plan["runs"]}
+coarse, fine = est["translate-trilinear_16"], est["translate-trilinear_32"]
+assert coarse["seconds"] is None and coarse["basis"].startswith("start band"), coarse
+assert fine["memory_mb"] > coarse["memory_mb"] > 64, (coarse, fine)
+png = Image.open(f"{d}/convergence.png")
+assert png.size == (1280, 1920), png.size  # a set of four panels per script
+report = open(f"{d}/report.md").read()
+assert "## rigid_motion" in report and "## translate" in report, report
+print("two scripts, --jobs 2: the same table; plan estimates; one panel set per script")
+PY
+
+# --- a voxel size a double does not hold exactly: its run is found again ----------------
+"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/odd" --voxel-sizes 0.07 -q
+"$cli" study "$data/studies/rigid_motion.json" -o "$tmp/odd" --voxel-sizes 0.07 2>"$tmp/err"
+grep -q "1 runs (1 reused from before, 0 failed)" "$tmp/err" || fail "0.07 again: $(cat "$tmp/err")"
+
+# --- the plan run step by step, as any other engine runs it (a shell loop) --------------
+"$cli" study "${two[@]}" -o "$tmp/loop" "${sizes[@]}" --plan-only -q
+"$cli" study -o "$tmp/loop" --list >"$tmp/ids"
+[ "$(wc -l <"$tmp/ids")" = 8 ] || fail "--list: $(cat "$tmp/ids")"
+while read -r id; do "$cli" study -o "$tmp/loop" --run "$id" -q; done <"$tmp/ids"
+[ -z "$("$cli" study -o "$tmp/loop" --list)" ] || fail "runs left after running them all"
+"$cli" study -o "$tmp/loop" --merge -q
+"$py" "$(dirname "$0")/same_table.py" "$tmp/jobs1/study.csv" "$tmp/loop/study.csv"
+refuses "sweepers-cli: $tmp/loop: the study has no run 'nope' (its runs: $(paste -sd, "$tmp/ids" | sed 's/,/, /g'))" \
+  study -o "$tmp/loop" --run nope
+refuses "sweepers-cli: $tmp/none: no study plan there (plan.json); plan one with sweepers-cli study SCRIPT... -o $tmp/none" \
+  study -o "$tmp/none" --merge
+# A script edited after planning: its runs refuse, rather than mix two scripts' results.
+cp "$tmp/translate.json" "$tmp/edited.json"
+"$cli" study "$tmp/edited.json" -o "$tmp/edit" --voxel-sizes 1/16 --plan-only -q
+sed -i 's/0.2, 0.1, 0/0.25, 0.1, 0/' "$tmp/edited.json"
+rc=0
+"$cli" study -o "$tmp/edit" --run edited-trilinear_16 2>"$tmp/err" || rc=$?
+[ "$rc" = 1 ] && grep -q "changed since the study was planned" "$tmp/err" ||
+  fail "an edited script ran: $rc $(cat "$tmp/err")"
+echo "plan, list, run one by one, merge: the same table"
+
 # --- resuming after a SIGKILL ------------------------------------------------------------
 stopped KILL "$tmp/killed.err" '[ -f "$tmp/killed/study.csv" ] && [ "$(wc -l <"$tmp/killed/study.csv")" -ge 3 ]' \
   study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/64 -q
 done_rows=$(($(wc -l <"$tmp/killed/study.csv") - 1))
 [ "$done_rows" -ge 2 ] || fail "the study wrote $done_rows rows before it was killed"
-stamp() { stat -c %y "$tmp/killed/trilinear_16.vdb" "$tmp/killed/trilinear_32.vdb"; }
+stamp() { stat -c %y "$tmp/killed/runs/rigid_motion-trilinear_16/grid.vdb" "$tmp/killed/runs/rigid_motion-trilinear_32/grid.vdb"; }
 before=$(stamp)
 "$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/64 \
   2>"$tmp/err"
@@ -152,7 +209,9 @@ grep -q "3 runs ($done_rows reused from before, 0 failed)" "$tmp/err" ||
   fail "resume: $(cat "$tmp/err"), expected $done_rows reused"
 [ "$(stamp)" = "$before" ] || fail "a finished run was redone"
 [ "$(wc -l <"$tmp/killed/study.csv")" -eq 4 ] || fail "the resumed table does not hold 3 rows"
-if ls "$tmp/killed" | grep -q "tmp-"; then fail "temporary files left: $(ls "$tmp/killed")"; fi
+if find "$tmp/killed" -name "*.tmp-*" | grep -q .; then
+  fail "temporary files left: $(find "$tmp/killed" -name "*.tmp-*")"
+fi
 echo "resumed after SIGKILL: $done_rows of 3 runs reused"
 
 # --- Ctrl-C: the finished runs are kept and said ------------------------------------------

@@ -1,8 +1,7 @@
 // The pieces of a grid-resolution study that need no grid: variants, observed orders, and
-// the table a study resumes from.
+// a run's result as the table is made from it.
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 
 #include <gtest/gtest.h>
 
@@ -66,7 +65,7 @@ TEST(Study, TheReportMarksARunWhoseTopologyIsNotTheExactShapes) {
     rows[0].euler = 0;
     rows[0].genus = 1;
     fillOrders(rows);
-    const std::string report = studyReport(rows, "poke.json");
+    const std::string report = studyReport(rows, {});
     EXPECT_NE(report.find("| 0 | 1 | 1 (exact: Euler 2, genus 0, 1 component) |"),
               std::string::npos)
         << report;
@@ -82,73 +81,63 @@ TEST(Study, AHistoryThatTearsSpaceClaimsNoExactTopology) {
     rows[0].euler = 0;
     rows[0].genus = 1;
     rows[0].referenceTopologyKnown = false;
-    const std::string report = studyReport(rows, "pinch_torus.json");
+    const std::string report = studyReport(rows, {});
     EXPECT_EQ(report.find("(exact:"), std::string::npos) << report;
-    const std::string path = ::testing::TempDir() + "study_torn.csv";
-    std::ofstream(path) << studyCsv(rows);
-    const std::vector<StudyRow> back = readStudyCsv(path);
-    ASSERT_EQ(back.size(), 1u);
-    EXPECT_FALSE(back[0].referenceTopologyKnown);
-    EXPECT_EQ(back[0].genus, 1);
+    const StudyRow back = studyRowFromJson(studyRowJson(rows[0], true), "row");
+    EXPECT_FALSE(back.referenceTopologyKnown);
+    EXPECT_EQ(back.genus, 1);
 }
 
-TEST(Study, TableReadsBackWhatWasWritten) {
+TEST(Study, ARunsResultReadsBackWhatWasWritten) {
     std::vector<StudyRow> rows = {row("trilinear", 1.0 / 32, 4e-3, 1e-3),
                                   row("trilinear", 1.0 / 64, 1e-3)};
     rows[1].error.signFlips = 7;
-    rows[1].wallSeconds = 1.25;
+    rows[1].wallSeconds = 1.0 / 3.0;
     rows[1].error.meshVolume = 0.5 - 2.5e-4;
+    rows[1].host = "node-17";
+    rows[1].threads = 8;
     rows.push_back(row("cubic", 0.03, 0.0));
     rows.back().failure = "a \"quoted\", comma'd reason";
+    for (StudyRow& r : rows)
+        r.script = "poke";
     fillOrders(rows);
-    const std::string path = ::testing::TempDir() + "study_table.csv";
-    std::ofstream(path) << studyCsv(rows);
-    const std::vector<StudyRow> back = readStudyCsv(path);
-    ASSERT_EQ(back.size(), 3u);
+    std::vector<StudyRow> back;
+    for (const StudyRow& r : rows)
+        back.push_back(studyRowFromJson(studyRowJson(r, true), "result.json"));
+    EXPECT_EQ(back[1].script, "poke");
     EXPECT_EQ(back[1].variant, "trilinear");
-    EXPECT_EQ(back[1].voxelSize, 1.0 / 64); // exactly: resuming matches runs by it
+    EXPECT_EQ(back[1].voxelSize, 1.0 / 64); // exactly: a result is matched to its run by it
     EXPECT_EQ(back[1].error.signFlips, 7u);
-    EXPECT_DOUBLE_EQ(back[1].wallSeconds, 1.25);
-    EXPECT_NEAR(back[1].orderRms, 2.0, 1e-3);
+    EXPECT_EQ(back[1].wallSeconds, 1.0 / 3.0); // every digit, for the table made from it
+    EXPECT_EQ(back[1].host, "node-17");
+    EXPECT_EQ(back[1].threads, 8);
+    EXPECT_TRUE(std::isnan(back[0].orderRms));
+    EXPECT_NEAR(back[1].orderRms, 2.0, 1e-12);
     EXPECT_DOUBLE_EQ(back[1].error.referenceVolume, 0.5);
-    EXPECT_NEAR(back[1].error.volumeError(), -2.5e-4, 1e-12);
-    EXPECT_NEAR(back[1].orderVolume, 2.0, 1e-3);
+    EXPECT_NEAR(back[1].error.volumeError(), -2.5e-4, 1e-15);
     EXPECT_EQ(back[1].referenceEuler, 2);
     EXPECT_EQ(back[1].referenceComponents, 1u);
     EXPECT_TRUE(back[1].referenceTopologyKnown);
     EXPECT_EQ(back[2].failure, rows[2].failure);
     EXPECT_EQ(studyRunName(back[1]), "trilinear_64");
-    EXPECT_EQ(studyRunName(back[2]), "cubic_0.03");
-    std::ofstream(path) << "not,a,study\n";
-    EXPECT_THROW(readStudyCsv(path), FileError);
-    // A table of another version (its columns differ) is refused, not misread.
-    const std::string table = studyCsv(rows);
-    const std::string header = table.substr(0, table.find('\n') + 1);
-    std::string older = table;
-    older.replace(older.find(",volume_ref,volume_err,order_volume"), 35, "");
-    std::ofstream(path) << older;
-    try {
-        readStudyCsv(path);
-        ADD_FAILURE() << "a table with other columns was read";
-    } catch (const FileError& e) {
-        EXPECT_NE(std::string(e.what()).find("other columns"), std::string::npos) << e.what();
+    EXPECT_EQ(studyRunId(back[2]), "poke-cubic_0.03");
+    // The table is the same whether made from the rows or from what was read back.
+    EXPECT_EQ(studyCsv(back), studyCsv(rows));
+    // A damaged count or voxel size is refused, not converted.
+    const nlohmann::json good = studyRowJson(rows[1], true);
+    for (const nlohmann::json& bad :
+         {nlohmann::json(-1), nlohmann::json(1e300), nlohmann::json(2.5), nlohmann::json("7")}) {
+        nlohmann::json damaged = good;
+        damaged["sign_flips"] = bad;
+        EXPECT_THROW(studyRowFromJson(damaged, "result.json"), FileError) << bad;
     }
-    // A damaged count or voxel size is refused, not converted: the table's first row with
-    // its sign_flips (field 19) or voxel size (field 2) replaced.
-    for (const char* bad : {"-1", "1e300", "nan", "2.5"}) {
-        std::string line =
-            table.substr(header.size(), table.find('\n', header.size()) + 1 - header.size());
-        std::size_t at = 0;
-        for (int c = 0; c < 18; ++c)
-            at = line.find(',', at) + 1;
-        line.replace(at, line.find(',', at) - at, bad);
-        std::ofstream(path) << header << line;
-        EXPECT_THROW(readStudyCsv(path), FileError) << "sign_flips " << bad;
-    }
-    std::ofstream(path) << header << "trilinear,-0.5" << std::string(24, ',') << "\n";
-    EXPECT_THROW(readStudyCsv(path), FileError) << "a negative voxel size";
-    std::remove(path.c_str());
-    EXPECT_TRUE(readStudyCsv(path).empty()); // no table yet: nothing to resume
+    nlohmann::json damaged = good;
+    damaged["voxel_size"] = -0.5;
+    EXPECT_THROW(studyRowFromJson(damaged, "result.json"), FileError) << "a negative voxel size";
+    damaged = good;
+    damaged.erase("err_rms");
+    EXPECT_THROW(studyRowFromJson(damaged, "result.json"), FileError) << "a column missing";
+    EXPECT_THROW(studyRowFromJson(nlohmann::json::array(), "result.json"), FileError);
 }
 
 } // namespace
