@@ -22,6 +22,7 @@ namespace {
 
 std::vector<char*> argvOf(const std::vector<std::string>& args) {
     std::vector<char*> out;
+    out.reserve(args.size() + 1);
     for (const std::string& a : args)
         out.push_back(const_cast<char*>(a.c_str()));
     out.push_back(nullptr);
@@ -57,8 +58,12 @@ bool onPath(const std::string& name) {
     const char* path = std::getenv("PATH");
     std::stringstream dirs(path ? path : "/usr/bin:/bin");
     std::string dir;
-    while (std::getline(dirs, dir, ':'))
-        if (!dir.empty() && ::access((dir + "/" + name).c_str(), X_OK) == 0) return true;
+    while (std::getline(dirs, dir, ':')) {
+        if (dir.empty()) continue;
+        dir += '/';
+        dir += name;
+        if (::access(dir.c_str(), X_OK) == 0) return true;
+    }
     return false;
 }
 

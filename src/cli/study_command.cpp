@@ -112,7 +112,7 @@ std::string joined(const std::vector<std::string>& items) {
 // The closing lines of a study, its --json object and its exit code: done when every run
 // finished and the plots were drawn.
 int finishStudy(const StudyPlan& plan, const StudyResults& results, std::size_t reused,
-                const std::string& plotsError, json extra = json::object()) {
+                const std::string& plotsError, const json& extra = json::object()) {
     const std::string csv = plan.dir + "/study.csv", report = plan.dir + "/report.md";
     const std::size_t failed = results.failedIds.size(), missing = results.missingIds.size();
     gOut.say("wrote " + csv + " and " + report + ": " + std::to_string(results.rows.size()) +
