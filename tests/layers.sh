@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The layers of src/ only depend downwards:
-#   core < tools < deform < levelset < mesh < sculpt < study < io < app, cli
+#   core < tools < deform < levelset < mesh < sculpt < study < io < app, cli < python
 # A file may include headers of its own layer and of layers below it; app and cli do not
 # include each other; the window-free part of app (app_core) includes no GL, GLFW window
 # or ImGui code. CMake links one library per layer in the same order.
@@ -9,7 +9,7 @@ src=$(cd "$(dirname "$0")/../src" && pwd)
 rank() {
   case $1 in
     core) echo 0 ;; tools) echo 1 ;; deform) echo 2 ;; levelset) echo 3 ;; mesh) echo 4 ;;
-    sculpt) echo 5 ;; study) echo 6 ;; io) echo 7 ;; app | cli) echo 8 ;;
+    sculpt) echo 5 ;; study) echo 6 ;; io) echo 7 ;; app | cli) echo 8 ;; python) echo 9 ;;
     *) echo "unknown layer $1" >&2; exit 2 ;;
   esac
 }

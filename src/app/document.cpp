@@ -118,9 +118,10 @@ SegmentReport Document::extendStroke(const Placement& next) {
     return r;
 }
 
-SegmentReport Document::applyStroke(const Stroke& stroke) {
+SegmentReport Document::applyStroke(const Stroke& stroke,
+                                    const std::function<void(const SegmentReport&)>& each) {
     if (!inEdit_ || inStroke_) throw std::logic_error("applyStroke outside an edit");
-    SegmentReport last = cancellable([&] { return sculptor_.applyStroke(stroke); });
+    SegmentReport last = cancellable([&] { return sculptor_.applyStroke(stroke, each); });
     applied_.push_back(stroke);
     return last;
 }

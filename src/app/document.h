@@ -9,6 +9,7 @@
 #pragma once
 
 #include <deque>
+#include <functional>
 #include <string>
 
 #include "io/stroke_script.h"
@@ -71,7 +72,9 @@ class Document {
     // Whole strokes (swirls, inflations, or complete sweeps) applied one after another;
     // those applied between beginEdit and endEdit are one undo step (one drag).
     void beginEdit();
-    SegmentReport applyStroke(const Stroke& stroke);
+    // `each` sees every segment's report (its deformation as planned, for an exact reference).
+    SegmentReport applyStroke(const Stroke& stroke,
+                              const std::function<void(const SegmentReport&)>& each = {});
     void endEdit();
 
     bool canUndo() const { return !undo_.empty() || !dropped_.empty(); }

@@ -58,7 +58,10 @@ bool serveReadIfAsked() {
     std::vector<std::string> args;
     for (std::string arg; std::getline(cmdline, arg, '\0');)
         args.push_back(arg);
-    if (args.size() != 5 || args[1] != kMarker) return false;
+    // The marker and its three arguments end the command line (a reader started through an
+    // interpreter has the interpreter's own arguments before them).
+    if (args.size() < 5 || args[args.size() - 4] != kMarker) return false;
+    args.erase(args.begin(), args.end() - 5);
     // One thread: its memory limit holds the reader's work, not a stack and a malloc arena
     // (tens of megabytes of address space each) for each of the machine's cores.
     const tbb::global_control oneThread(tbb::global_control::max_allowed_parallelism, 1);
@@ -123,7 +126,16 @@ std::string selfPath() {
     return std::string(buf.data(), std::size_t(n));
 }
 
+std::vector<std::string>& readerCommand() {
+    static std::vector<std::string> command;
+    return command;
+}
+
 } // namespace
+
+void setReaderCommand(std::vector<std::string> command) {
+    readerCommand() = std::move(command);
+}
 
 namespace {
 
@@ -141,7 +153,9 @@ ChildRead readInChild(const char* kind, const std::string& path, const std::stri
                       const ReadLimits& limits) {
     (void)gServed;
     initVdb();
-    const std::string self = selfPath();
+    std::vector<std::string> command = readerCommand();
+    if (command.empty()) command.push_back(selfPath());
+    const std::string self = command.front();
     int out[2], err[2];
     if (::pipe2(out, O_CLOEXEC) != 0) throw FileError("cannot start the file reader (pipe)");
     if (::pipe2(err, O_CLOEXEC) != 0) {
@@ -150,8 +164,12 @@ ChildRead readInChild(const char* kind, const std::string& path, const std::stri
         throw FileError("cannot start the file reader (pipe)");
     }
     const double bytes = limits.bytes > 0 ? limits.bytes : readerMemory(path);
-    std::vector<const char*> argv{self.c_str(), kMarker,          kind,
-                                  path.c_str(), gridName.c_str(), nullptr};
+    std::vector<const char*> argv;
+    for (const std::string& a : command)
+        argv.push_back(a.c_str());
+    for (const char* a : {kMarker, kind, path.c_str(), gridName.c_str()})
+        argv.push_back(a);
+    argv.push_back(nullptr);
     // The child's environment: the parent's, and under AddressSanitizer a resident-memory
     // limit in its options (AddressSanitizer cannot run under an address-space limit, and
     // without a limit a damaged file could make the reader allocate gigabytes).

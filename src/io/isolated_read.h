@@ -11,6 +11,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "io/vdb_file.h"
 #include "io/velocity_file.h"
@@ -22,6 +23,11 @@ struct ReadLimits {
     double bytes = 0.0;     // address space of the child; 0: 64 times the file, at least
                             // 512 MB, at most the memory available
 };
+
+// The command that starts a reader, before the marker and its arguments: by default this
+// executable. A host whose executable is not ours (the Python module, in an interpreter)
+// names one that loads this layer, such as {python3, -c, "import sweepers"}.
+void setReaderCommand(std::vector<std::string> command);
 
 // readLevelSetInProcess(path, gridName) (io/vdb_file.h) in a child process. Throws FileError with
 // the child's own message when it refuses the file, or saying that the file is damaged

@@ -88,4 +88,10 @@ GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir, 
     return nullptr;
 }
 
+ExactReference::StartFunction exactStart(const StrokeScript& script, const GridPtr& start) {
+    if (script.start.kind == StartShape::Kind::Sphere)
+        return ExactReference::sphere(script.start.center, script.start.radius);
+    return ExactReference::sampled(start->deepCopy());
+}
+
 } // namespace sweepers

@@ -6,6 +6,7 @@
 
 #include "levelset/interrupt.h"
 #include "sculpt/stroke.h"
+#include "study/reference.h"
 
 namespace sweepers {
 
@@ -15,6 +16,10 @@ namespace sweepers {
 GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir,
                       double voxelSize = 0.0, Interrupter* interrupter = nullptr,
                       bool force = false);
+
+// The start shape as the exact reference of a history starts from it (study/reference.h):
+// a sphere's own distance, or `start` (the grid makeStartGrid made) sampled.
+ExactReference::StartFunction exactStart(const StrokeScript& script, const GridPtr& start);
 
 // The checks makeStartGrid makes before it reads or builds anything: the half-width, and for
 // a sphere its size in voxels and the memory its band needs. `check` makes them too.

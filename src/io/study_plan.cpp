@@ -316,11 +316,8 @@ StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run, Interrupt
         const StrokeScript script = readStrokeScript(source.path);
         const GridPtr start =
             makeStartGrid(script, directoryOf(source.path), run.voxelSize, interrupter, plan.force);
-        const ExactReference::StartFunction shape =
-            script.start.kind == StartShape::Kind::Sphere
-                ? ExactReference::sphere(script.start.center, script.start.radius)
-                : ExactReference::sampled(start->deepCopy());
-        done = runStudyCase(start, script.strokes, shape, run.variant, interrupter, progress);
+        done = runStudyCase(start, script.strokes, exactStart(script, start), run.variant,
+                            interrupter, progress);
         AtomicWrite vdb = prepareLevelSet(*done->grid, dir + "/grid.vdb");
         AtomicWrite mesh = prepareMesh(done->mesh, dir + "/mesh.ply");
         vdb.commit();

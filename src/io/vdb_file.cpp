@@ -3,8 +3,10 @@
 #include <cmath>
 #include <fstream>
 #include <new>
+#include <sstream>
 
 #include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
 
 #include "core/format.h"
 #include "io/atomic_file.h"
@@ -126,8 +128,11 @@ class FileWriter : public openvdb::io::Archive {
 
 } // namespace
 
-AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path, const openvdb::MetaMap& meta,
-                            const openvdb::GridCPtrVec& beside) {
+namespace {
+
+// The grids of a level-set file: the level set with its metadata, then `beside`.
+openvdb::GridCPtrVec levelSetFileGrids(const Grid& grid, const openvdb::MetaMap& meta,
+                                       const openvdb::GridCPtrVec& beside) {
     initVdb();
     // The file's metadata is put together on a grid without voxels and written with the
     // grid's own tree (shared, only read): a deep copy of the voxels, to add a few names,
@@ -139,7 +144,20 @@ AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path, const ope
         named->insertMeta(it->first, *it->second);
     openvdb::GridCPtrVec grids{grid.copyReplacingMetadata(*named)};
     grids.insert(grids.end(), beside.begin(), beside.end());
-    return prepareGrids(grids, path);
+    return grids;
+}
+
+} // namespace
+
+AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path, const openvdb::MetaMap& meta,
+                            const openvdb::GridCPtrVec& beside) {
+    return prepareGrids(levelSetFileGrids(grid, meta, beside), path);
+}
+
+std::string levelSetStream(const Grid& grid) {
+    std::ostringstream out(std::ios::binary);
+    openvdb::io::Stream(out).write(levelSetFileGrids(grid, {}, {}));
+    return out.str();
 }
 
 AtomicWrite prepareGrids(const openvdb::GridCPtrVec& grids, const std::string& path) {

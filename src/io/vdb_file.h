@@ -48,6 +48,9 @@ void writeLevelSet(const Grid& grid, const std::string& path);
 AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path,
                             const openvdb::MetaMap& meta = {},
                             const openvdb::GridCPtrVec& beside = {});
+// The level set as prepareLevelSet writes it, as the bytes of an in-memory VDB stream
+// (openvdb::io::Stream), which pyopenvdb's grids unpickle.
+std::string levelSetStream(const Grid& grid);
 // Any grids, in OpenVDB's file format, written and flushed but not yet in place.
 AtomicWrite prepareGrids(const openvdb::GridCPtrVec& grids, const std::string& path);
 

@@ -45,6 +45,24 @@ fi
 grep -q "cannot find the shaders" moved.err || fail "without shaders: $(cat moved.err)"
 echo "installed modeler: clay on screen with its own shaders, one line without them"
 
+# The installed Python module, with its type hints, where Debian's python3 looks under the
+# prefix (lib/python3.X/dist-packages), imported from elsewhere.
+site=$("$py" -c 'import sys; print(f"lib/python3.{sys.version_info[1]}/dist-packages")')
+if [ -e "$build/python" ]; then
+  ls "$prefix/$site"/sweepers.*.so >/dev/null 2>&1 || fail "cmake --install put no module in $site"
+  [ -e "$prefix/$site/sweepers.pyi" ] || fail "cmake --install put no sweepers.pyi in $site"
+  preload=""
+  [ -n "${SWEEPERS_ASAN_RUNTIME:-}" ] && preload=$SWEEPERS_ASAN_RUNTIME
+  LD_PRELOAD=$preload ASAN_OPTIONS=detect_leaks=0 PYTHONPATH="$prefix/$site" "$py" -c '
+import sweepers, sys
+s = sweepers.Sculptor(voxel_size=0.0625)
+s.apply({"type": "inflate", "at": [0, 1, 0], "radius": 0.4})
+assert sweepers.__file__.startswith(sys.argv[1]), sweepers.__file__
+assert s.topology["genus"] == 0 and s.mesh()[0].shape[1] == 3
+' "$prefix" || fail "the installed Python module did not work"
+  echo "installed Python module: imported from $site, sculpts"
+fi
+
 # --- the Debian package -----------------------------------------------------------------
 cpack -G DEB --config "$build/CPackConfig.cmake" -B "$tmp/pkg" >"$tmp/cpack.log" 2>&1 ||
   fail "cpack: $(tail -5 "$tmp/cpack.log")"
@@ -54,6 +72,10 @@ for f in ./usr/bin/sweepers ./usr/bin/sweepers-cli ./usr/share/sweepers/shaders/
   ./usr/share/sweepers/examples/drag.json; do
   grep -q " $f\$" "$tmp/contents" || fail "$(basename "$deb") holds no $f"
 done
+if [ -e "$build/python" ]; then
+  grep -q " ./usr/lib/python3/dist-packages/sweepers\..*\.so\$" "$tmp/contents" ||
+    fail "$(basename "$deb") holds no Python module in /usr/lib/python3/dist-packages"
+fi
 depends=$(dpkg-deb -f "$deb" Depends)
 # Every package it depends on is one Debian has (here, installed by the build's own needs).
 for p in $(echo "$depends" | tr ',' '\n' | sed 's/(.*//; s/|.*//' | tr -d ' '); do

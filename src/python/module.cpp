@@ -1,0 +1,582 @@
+// `import sweepers`: the engine for Python notebooks (docs/python.md). The work is done by
+// python/shape.h and the io layer; this file turns Python's values into the engine's and
+// back, releases the GIL around engine work, turns Ctrl-C (SIGINT) into the engine's
+// cancellation, and the engine's errors into Python's exceptions.
+#include <atomic>
+#include <csignal>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+#include <dlfcn.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "io/isolated_read.h"
+#include "io/mesh_file.h"
+#include "io/start_grid.h"
+#include "io/stroke_script.h"
+#include "io/study_files.h"
+#include "io/study_plan.h"
+#include "io/vdb_file.h"
+#include "levelset/parallel.h"
+#include "python/shape.h"
+
+namespace py = pybind11;
+using namespace sweepers;
+using sweepers::python::Session;
+using sweepers::python::Shape;
+
+namespace {
+
+// --- Ctrl-C ------------------------------------------------------------------------------
+
+std::atomic<FlagInterrupter*> gInterrupted{nullptr};
+extern "C" void onInterrupt(int) {
+    if (FlagInterrupter* f = gInterrupted.load()) f->interrupt();
+}
+
+// While engine work runs (without the GIL, so Python's own handler would not run until it
+// ends), SIGINT stops it through the engine's interrupter. Python only handles signals on
+// its main thread, so only work started there is given the handler.
+class InterruptScope {
+  public:
+    InterruptScope() {
+        const py::module_ threading = py::module_::import("threading");
+        if (!threading.attr("current_thread")().is(threading.attr("main_thread")())) return;
+        gInterrupted.store(&flag);
+        struct sigaction action = {};
+        action.sa_handler = onInterrupt;
+        sigemptyset(&action.sa_mask);
+        installed_ = ::sigaction(SIGINT, &action, &previous_) == 0;
+    }
+    ~InterruptScope() {
+        if (installed_) ::sigaction(SIGINT, &previous_, nullptr);
+        gInterrupted.store(nullptr);
+    }
+    InterruptScope(const InterruptScope&) = delete;
+    InterruptScope& operator=(const InterruptScope&) = delete;
+    FlagInterrupter flag;
+
+  private:
+    struct sigaction previous_ = {};
+    bool installed_ = false;
+};
+
+// --- progress ----------------------------------------------------------------------------
+
+// A progress argument: None, a callable taking (done, total), or True for a tqdm bar when
+// tqdm is installed. An exception raised by the callable stops the work and is raised.
+class ProgressCall {
+  public:
+    ProgressCall(const py::object& progress, const std::string& what, FlagInterrupter* stop)
+        : stop_(stop) {
+        if (progress.is_none() || (py::isinstance<py::bool_>(progress) && !progress.cast<bool>()))
+            return;
+        if (py::isinstance<py::bool_>(progress)) {
+            try {
+                bar_ = py::module_::import("tqdm.auto")
+                           .attr("tqdm")(py::arg("desc") = what, py::arg("unit") = "step");
+            } catch (const py::error_already_set&) {
+                return; // no tqdm: no bar
+            }
+            return;
+        }
+        if (!PyCallable_Check(progress.ptr()))
+            throw py::type_error("progress: a callable (done, total), True or None");
+        callback_ = progress;
+    }
+    ~ProgressCall() {
+        if (bar_) {
+            try {
+                bar_.attr("close")();
+            } catch (const py::error_already_set&) {
+            }
+        }
+    }
+    ProgressCall(const ProgressCall&) = delete;
+    ProgressCall& operator=(const ProgressCall&) = delete;
+
+    // The engine's callback; called without the GIL.
+    Progress progress() {
+        if (!callback_ && !bar_) return {};
+        return [this](std::size_t done, std::size_t total) {
+            py::gil_scoped_acquire gil;
+            try {
+                if (callback_) {
+                    callback_(done, total);
+                } else {
+                    bar_.attr("total") = total;
+                    bar_.attr("n") = done;
+                    bar_.attr("refresh")();
+                }
+            } catch (py::error_already_set& e) {
+                if (!error_) error_.emplace(std::move(e));
+                stop_->interrupt();
+            }
+        };
+    }
+    // Raises the callback's exception, if it raised one.
+    void raiseCallbackError() {
+        if (error_) {
+            py::error_already_set e = std::move(*error_);
+            error_.reset();
+            throw e;
+        }
+    }
+
+  private:
+    FlagInterrupter* stop_;
+    py::object callback_, bar_;
+    std::optional<py::error_already_set> error_;
+};
+
+// Runs engine work without the GIL, stoppable by Ctrl-C, with progress.
+template <typename Work>
+auto runEngine(const py::object& progress, const std::string& what, const Work& work) {
+    InterruptScope scope;
+    ProgressCall call(progress, what, &scope.flag);
+    const Progress report = call.progress();
+    try {
+        py::gil_scoped_release release;
+        return work(&scope.flag, report);
+    } catch (const Cancelled&) {
+        call.raiseCallbackError();
+        throw;
+    }
+}
+
+// --- values ------------------------------------------------------------------------------
+
+std::string textOf(const py::handle& value) {
+    return py::module_::import("json").attr("dumps")(value).cast<std::string>();
+}
+
+py::object fromJson(const std::string& text) {
+    return py::module_::import("json").attr("loads")(text);
+}
+
+bool isPath(const py::handle& value) {
+    return py::isinstance(value, py::module_::import("os").attr("PathLike"));
+}
+
+std::string pathOf(const py::handle& value) {
+    return py::str(py::module_::import("os").attr("fspath")(value)).cast<std::string>();
+}
+
+// A script given as a path, a JSON string or a dict, and the directory its files are
+// relative to.
+struct GivenScript {
+    StrokeScript script;
+    std::string baseDir;
+};
+GivenScript scriptFrom(const py::handle& value) {
+    const std::string here = std::filesystem::current_path().string();
+    if (py::isinstance<py::dict>(value))
+        return {parseStrokeScript(textOf(value), "the script (a dict)", here), here};
+    if (!py::isinstance<py::str>(value) && !isPath(value))
+        throw py::type_error("script: a path, a JSON string or a dict, not " +
+                             py::str(py::type::of(value)).cast<std::string>());
+    const std::string text = pathOf(value);
+    const std::size_t first = text.find_first_not_of(" \t\r\n");
+    if (py::isinstance<py::str>(value) && first != std::string::npos && text[first] == '{')
+        return {parseStrokeScript(text, "the script (a JSON string)", here), here};
+    try {
+        return {readStrokeScript(text), directoryOf(text)};
+    } catch (const ScriptError& e) {
+        // The CLI's message, as an OSError when the file cannot be read at all.
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(text, ec)) throw FileError(e.what());
+        throw;
+    }
+}
+
+double voxelSizeFrom(const py::object& value) {
+    if (value.is_none()) return 0.0;
+    const double h = value.cast<double>();
+    if (!(h > 0.0 && std::isfinite(h)))
+        throw std::invalid_argument("voxel_size must be a positive number, not " +
+                                    py::repr(value).cast<std::string>());
+    return h;
+}
+
+std::vector<Eigen::Vector3d>
+pointsFrom(const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
+    if (points.ndim() != 2 || points.shape(1) != 3)
+        throw std::invalid_argument("points: an n x 3 array");
+    std::vector<Eigen::Vector3d> out(std::size_t(points.shape(0)));
+    const auto p = points.unchecked<2>();
+    for (py::ssize_t i = 0; i < points.shape(0); ++i)
+        out[std::size_t(i)] = {p(i, 0), p(i, 1), p(i, 2)};
+    return out;
+}
+
+py::array_t<double> arrayOf(const std::vector<double>& values) {
+    py::array_t<double> out(py::ssize_t(values.size()));
+    std::copy(values.begin(), values.end(), out.mutable_data());
+    return out;
+}
+
+py::dict topologyOf(const LevelSetMeasures& m) {
+    py::dict t;
+    t["euler_characteristic"] = m.eulerCharacteristic;
+    t["genus"] = m.genus;
+    t["components"] = m.components;
+    return t;
+}
+
+py::tuple meshArrays(const TriangleMesh& mesh) {
+    py::array_t<float> vertices({py::ssize_t(mesh.positions.size()), py::ssize_t(3)});
+    py::array_t<std::int32_t> triangles({py::ssize_t(mesh.triangles.size()), py::ssize_t(3)});
+    auto v = vertices.mutable_unchecked<2>();
+    auto t = triangles.mutable_unchecked<2>();
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            v(py::ssize_t(i), k) = mesh.positions[i][k];
+    for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+        for (int k = 0; k < 3; ++k)
+            t(py::ssize_t(i), k) = mesh.triangles[i][k];
+    return py::make_tuple(vertices, triangles);
+}
+
+py::object toPyopenvdb(const std::string& bytes) {
+    py::module_ vdb;
+    try {
+        vdb = py::module_::import("pyopenvdb");
+    } catch (const py::error_already_set&) {
+        throw py::import_error("to_pyopenvdb: pyopenvdb is not installed "
+                               "(Debian: python3-openvdb, for /usr/bin/python3)");
+    }
+    // pyopenvdb's grids pickle as (their __dict__, the bytes of a VDB stream).
+    py::object grid = vdb.attr("FloatGrid")();
+    grid.attr("__setstate__")(py::make_tuple(py::dict(), py::bytes(bytes)));
+    return grid;
+}
+
+// The methods a Shape and a Sculptor share, on the shape `of(self)` gives.
+template <typename Class, typename Of> void addShapeMethods(Class& cls, const Of& of) {
+    cls.def_property_readonly(
+           "volume", [of](const typename Class::type& s) { return of(s).measures().volume; },
+           "The enclosed volume (world units cubed).")
+        .def_property_readonly(
+            "area", [of](const typename Class::type& s) { return of(s).measures().area; },
+            "The surface area (world units squared).")
+        .def_property_readonly(
+            "voxel_size",
+            [of](const typename Class::type& s) { return of(s).grid().voxelSize()[0]; },
+            "The grid's voxel size.")
+        .def_property_readonly(
+            "topology",
+            [of](const typename Class::type& s) { return topologyOf(of(s).measures()); },
+            "{'euler_characteristic', 'genus', 'components'} of the surface.")
+        .def(
+            "mesh",
+            [of](const typename Class::type& s) {
+                const Shape& shape = of(s);
+                TriangleMesh mesh;
+                {
+                    py::gil_scoped_release release;
+                    mesh = shape.mesh();
+                }
+                return meshArrays(mesh);
+            },
+            "The surface as (vertices float32 n x 3, triangles int32 m x 3): the welded mesh "
+            "that `sweepers-cli apply --mesh` exports.")
+        .def(
+            "sample",
+            [of](const typename Class::type& s,
+                 const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
+                const std::vector<Eigen::Vector3d> p = pointsFrom(points);
+                const Shape& shape = of(s);
+                std::vector<double> values;
+                {
+                    py::gil_scoped_release release;
+                    values = shape.sample(p);
+                }
+                return arrayOf(values);
+            },
+            py::arg("points"),
+            "The grid's signed distance (trilinear, negative inside) at an n x 3 array of "
+            "points.")
+        .def(
+            "exact_distance",
+            [of](const typename Class::type& s,
+                 const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
+                const std::vector<Eigen::Vector3d> p = pointsFrom(points);
+                const Shape& shape = of(s);
+                std::vector<double> values;
+                {
+                    py::gil_scoped_release release;
+                    values = shape.exactDistance(p);
+                }
+                return arrayOf(values);
+            },
+            py::arg("points"),
+            "The exact shape's implicit function at an n x 3 array of points: the start "
+            "pulled back through the inverse of every deformation applied, the reference "
+            "`study` measures against (a distance for a sphere start near the surface; "
+            "negative inside).")
+        .def(
+            "to_vdb_bytes",
+            [of](const typename Class::type& s) { return py::bytes(of(s).vdbBytes()); },
+            "The level set as a VDB stream in memory (openvdb::io::Stream), as `apply` "
+            "writes it.")
+        .def(
+            "to_pyopenvdb",
+            [of](const typename Class::type& s) { return toPyopenvdb(of(s).vdbBytes()); },
+            "The level set as a pyopenvdb.FloatGrid (needs pyopenvdb).")
+        .def(
+            "save",
+            [of](const typename Class::type& s, const py::object& path) {
+                const std::string p = pathOf(path);
+                const Shape& shape = of(s);
+                py::gil_scoped_release release;
+                shape.save(p);
+            },
+            py::arg("path"),
+            "Writes the level set (.vdb) or its surface (.obj, .ply, .stl), atomically.");
+}
+
+// A Sculptor's start: None (a unit sphere), a dict as a script's "start", or a path to a
+// .vdb or a mesh.
+py::object startFrom(const py::object& start) {
+    if (start.is_none()) {
+        py::dict sphere, at;
+        at["center"] = py::make_tuple(0.0, 0.0, 0.0);
+        at["radius"] = 1.0;
+        sphere["sphere"] = at;
+        return std::move(sphere);
+    }
+    if (py::isinstance<py::dict>(start)) return start;
+    if (py::isinstance<py::str>(start) || isPath(start)) {
+        const std::string path = pathOf(start);
+        py::dict file;
+        file[isMeshPath(path) ? "mesh" : "vdb"] = std::filesystem::absolute(path).string();
+        return std::move(file);
+    }
+    throw py::type_error("start: None (a unit sphere), a dict such as {'sphere': {'center': "
+                         "[0, 0, 0], 'radius': 1}}, or a path to a .vdb or a mesh");
+}
+
+std::vector<Stroke> strokesFrom(const py::object& strokes) {
+    py::list list;
+    if (py::isinstance<py::dict>(strokes))
+        list.append(strokes);
+    else if (py::isinstance<py::list>(strokes) || py::isinstance<py::tuple>(strokes))
+        list = py::list(strokes);
+    else
+        throw py::type_error("strokes: a stroke (a dict) or a list of them");
+    py::dict script;
+    script["sweepers"] = 1;
+    script["strokes"] = list;
+    return parseStrokeScript(textOf(script), "the strokes",
+                             std::filesystem::current_path().string())
+        .strokes;
+}
+
+// --- study -------------------------------------------------------------------------------
+
+double voxelSizeOf(const py::handle& value) {
+    if (py::isinstance<py::str>(value)) {
+        const std::string text = value.cast<std::string>();
+        try {
+            std::size_t used = 0;
+            const bool fraction = text.rfind("1/", 0) == 0;
+            const double v = std::stod(fraction ? text.substr(2) : text, &used);
+            if (used == text.size() - (fraction ? 2 : 0) && v > 0.0 && std::isfinite(v))
+                return fraction ? 1.0 / v : v;
+        } catch (const std::exception&) {
+        }
+        throw std::invalid_argument("voxel_sizes: '" + text +
+                                    "' is not a voxel size (a number, or '1/N')");
+    }
+    return voxelSizeFrom(py::reinterpret_borrow<py::object>(value));
+}
+
+py::object study(const py::object& scripts, const py::object& voxelSizes,
+                 const py::object& variants, const py::object& directory, bool force,
+                 const py::object& progress) {
+    std::vector<std::string> paths;
+    if (py::isinstance<py::str>(scripts) || isPath(scripts))
+        paths.push_back(pathOf(scripts));
+    else
+        for (const py::handle s : scripts)
+            paths.push_back(pathOf(s));
+    std::vector<double> sizes;
+    for (const py::handle h : voxelSizes)
+        sizes.push_back(voxelSizeOf(h));
+    std::sort(sizes.begin(), sizes.end(), std::greater<>());
+    std::vector<StudyVariant> kinds;
+    for (const py::handle v : py::isinstance<py::str>(variants) ? py::list(py::make_tuple(variants))
+                                                                : py::list(variants)) {
+        const auto kind = parseVariant(v.cast<std::string>());
+        if (!kind)
+            throw std::invalid_argument("variants: unknown variant '" + v.cast<std::string>() +
+                                        "' (trilinear, cubic, per-substep, first-order)");
+        kinds.push_back(*kind);
+    }
+    if (paths.empty() || sizes.empty() || kinds.empty())
+        throw std::invalid_argument("study: no script, voxel size or variant given");
+    // Without a directory, a temporary one, removed after.
+    py::object temporary;
+    std::string dir;
+    if (directory.is_none()) {
+        temporary = py::module_::import("tempfile")
+                        .attr("TemporaryDirectory")(py::arg("prefix") = "sweepers-study-");
+        dir = temporary.attr("name").cast<std::string>();
+    } else {
+        dir = pathOf(directory);
+    }
+    StudyPlan plan = planStudy(paths, sizes, kinds, dir, force);
+    std::filesystem::create_directories(plan.dir);
+    const std::string json =
+        runEngine(progress, "study", [&](Interrupter* stop, const Progress& report) {
+            estimateStudyRuns(plan, int(loopThreads()));
+            writeStudyPlan(plan);
+            std::size_t done = 0;
+            for (const PlannedRun& run : plan.runs) {
+                if (!runIsDone(plan, run)) executeStudyRun(plan, run, stop);
+                if (report) report(++done, plan.runs.size());
+            }
+            const StudyResults results = collectStudyResults(plan);
+            mergeStudy(plan, results); // the plots need gnuplot; the rows do not
+            nlohmann::json rows = nlohmann::json::array();
+            for (const StudyRow& r : results.rows)
+                rows.push_back(studyRowJson(r));
+            return rows.dump();
+        });
+    if (temporary) temporary.attr("cleanup")();
+    py::object rows = fromJson(json);
+    try {
+        return py::module_::import("pandas").attr("DataFrame")(rows);
+    } catch (const py::error_already_set&) {
+        return rows; // no pandas: the rows as dicts
+    }
+}
+
+} // namespace
+
+PYBIND11_MODULE(sweepers, m) {
+    m.doc() = "Sweepers: sculpt narrow-band level sets with sweepers, measure them against the "
+              "exact shape, mesh them into numpy, hand them to pyopenvdb. See docs/python.md.";
+    m.attr("__version__") = SWEEPERS_VERSION;
+    initVdb();
+    // Files we did not write are read in a child process (io/isolated_read.h): here that
+    // child is this interpreter, importing this module from where it was loaded.
+    Dl_info self = {};
+    const std::string python = py::module_::import("sys").attr("executable").cast<std::string>();
+    if (!python.empty() && ::dladdr(reinterpret_cast<void*>(&onInterrupt), &self) != 0 &&
+        self.dli_fname) {
+        const std::string dir = std::filesystem::path(self.dli_fname).parent_path().string();
+        setReaderCommand({python, "-c",
+                          "import sys; sys.path.insert(0, " +
+                              py::repr(py::str(dir)).cast<std::string>() + "); import sweepers"});
+    }
+
+    // The engine's errors as Python's, with the message the CLI prints.
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const Cancelled&) {
+            PyErr_SetNone(PyExc_KeyboardInterrupt);
+        } catch (const ScriptError& e) {
+            PyErr_SetString(PyExc_ValueError, e.what());
+        } catch (const FileError& e) {
+            PyErr_SetString(PyExc_OSError, e.what());
+        }
+    });
+
+    py::class_<Shape> shape(m, "Shape",
+                            "A sculpted level set with the history that made it "
+                            "(sweepers.apply, Sculptor.shape()).");
+    addShapeMethods(shape, [](const Shape& s) -> const Shape& { return s; });
+
+    m.def(
+        "apply",
+        [](const py::object& script, const py::object& voxelSize, const py::object& progress) {
+            const GivenScript given = scriptFrom(script);
+            const double h = voxelSizeFrom(voxelSize);
+            return runEngine(progress, "apply", [&](Interrupter* stop, const Progress& report) {
+                return python::applyScript(given.script, given.baseDir, h, stop, report);
+            });
+        },
+        py::arg("script"), py::arg("voxel_size") = py::none(), py::arg("progress") = py::none(),
+        "Applies a stroke script (a path, a JSON string or a dict) at its voxel size or "
+        "`voxel_size`, as `sweepers-cli apply` does, and returns the Shape. `progress`: a "
+        "callable (done, total), True for a tqdm bar, or None.");
+
+    py::class_<Session> sculptor(m, "Sculptor",
+                                 "A sculpting session: strokes applied one call at a time, "
+                                 "each call one undo step. Its script() replays to the same "
+                                 "grid.");
+    sculptor
+        .def(py::init([](const py::object& start, const py::object& voxelSize,
+                         const py::object& halfWidth) {
+                 py::dict script;
+                 script["sweepers"] = 1;
+                 py::dict grid;
+                 const double h = voxelSizeFrom(voxelSize);
+                 if (h > 0.0) grid["voxel_size"] = h;
+                 if (!halfWidth.is_none()) grid["half_width"] = halfWidth.cast<double>();
+                 script["grid"] = grid;
+                 script["start"] = startFrom(start);
+                 script["strokes"] = py::list();
+                 const std::string here = std::filesystem::current_path().string();
+                 const StrokeScript parsed = parseStrokeScript(textOf(script), "the start", here);
+                 return runEngine(py::none(), "start", [&](Interrupter* stop, const Progress&) {
+                     return std::make_unique<Session>(parsed, here, stop);
+                 });
+             }),
+             py::arg("start") = py::none(), py::arg("voxel_size") = py::none(),
+             py::arg("half_width") = py::none(),
+             "start: None (a unit sphere at the origin), a dict as a script's 'start' "
+             "({'sphere': {...}}, {'vdb': path}, {'mesh': path}), or a path to a .vdb or a "
+             "mesh; voxel_size and half_width: the grid's (default 0.02 and 3 voxels; a .vdb "
+             "keeps its own).")
+        .def(
+            "apply",
+            [](Session& s, const py::object& strokes, const py::object& progress) {
+                const std::vector<Stroke> parsed = strokesFrom(strokes);
+                runEngine(progress, "sculpting", [&](Interrupter* stop, const Progress& report) {
+                    s.apply(parsed, stop, report);
+                    return 0;
+                });
+            },
+            py::arg("strokes"), py::arg("progress") = py::none(),
+            "Applies a stroke (a dict, as in a script's 'strokes') or a list of them, as one "
+            "undo step. Ctrl-C (KeyboardInterrupt) stops it and leaves the Sculptor as it was.")
+        .def(
+            "undo",
+            [](Session& s) {
+                return runEngine(py::none(), "undo",
+                                 [&](Interrupter*, const Progress&) { return s.undo(); });
+            },
+            "Takes back the last apply(); False when there is none.")
+        .def(
+            "redo",
+            [](Session& s) {
+                return runEngine(py::none(), "redo",
+                                 [&](Interrupter*, const Progress&) { return s.redo(); });
+            },
+            "Applies again what undo() took back; False when there is none.")
+        .def_property_readonly("can_undo", &Session::canUndo)
+        .def_property_readonly("can_redo", &Session::canRedo)
+        .def(
+            "script", [](const Session& s) { return fromJson(formatStrokeScript(s.script())); },
+            "The session as a stroke script (a dict): its start and every stroke applied. "
+            "`sweepers-cli apply` replays it to the same grid, voxel for voxel.")
+        .def(
+            "shape", [](const Session& s) { return s.shape(); },
+            "The shape now, as a Shape that later strokes do not change.");
+    addShapeMethods(sculptor, [](const Session& s) { return s.view(); });
+
+    m.def("study", &study, py::arg("scripts"), py::arg("voxel_sizes"),
+          py::arg("variants") = py::make_tuple("trilinear"), py::arg("directory") = py::none(),
+          py::arg("force") = false, py::arg("progress") = py::none(),
+          "Runs a grid-resolution study (docs/studies.md) of one or more scripts at each voxel "
+          "size (numbers or '1/N') and variant ('trilinear', 'cubic', 'per-substep', "
+          "'first-order') and returns its rows, keyed by the columns of study.csv: a pandas "
+          "DataFrame when pandas is installed, else a list of dicts. In `directory` (kept, and "
+          "resumed from) or a temporary one. `progress` sees runs done and in all.");
+}

@@ -1,0 +1,181 @@
+#include "python/shape.h"
+
+#include <openvdb/tools/Interpolation.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "io/mesh_file.h"
+#include "io/start_grid.h"
+#include "io/vdb_file.h"
+#include "mesh/marching_cubes.h"
+
+namespace sweepers::python {
+
+namespace {
+
+// The engine's values at many points, in parallel: `at(i)` for each.
+template <typename At> std::vector<double> forEachPoint(std::size_t n, const At& at) {
+    std::vector<double> out(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+            out[i] = at(i);
+    });
+    return out;
+}
+
+} // namespace
+
+Shape::Shape(std::shared_ptr<const Grid> grid, ExactReference::StartFunction start, History history)
+    : grid_(std::move(grid)), start_(std::move(start)), history_(std::move(history)) {}
+
+LevelSetMeasures Shape::measures() const {
+    return measureLevelSet(*grid_);
+}
+
+TriangleMesh Shape::mesh() const {
+    return meshLevelSet(*grid_);
+}
+
+std::vector<double> Shape::sample(const std::vector<Eigen::Vector3d>& points) const {
+    return forEachPoint(points.size(), [&](std::size_t i) {
+        // A sampler per call: its accessor caches nodes and is not shared between threads.
+        const openvdb::tools::GridSampler<Grid, openvdb::tools::BoxSampler> sampler(*grid_);
+        return double(sampler.wsSample(toVdb(points[i])));
+    });
+}
+
+std::vector<double> Shape::exactDistance(const std::vector<Eigen::Vector3d>& points) const {
+    ExactReference reference(start_);
+    for (const auto& d : history_)
+        reference.append(d);
+    return forEachPoint(points.size(), [&](std::size_t i) { return reference.value(points[i]); });
+}
+
+std::string Shape::vdbBytes() const {
+    return levelSetStream(*grid_);
+}
+
+void Shape::save(const std::string& path) const {
+    if (isMeshPath(path)) {
+        writeMesh(mesh(), path);
+        return;
+    }
+    writeLevelSet(*grid_, path);
+}
+
+Shape applyScript(const StrokeScript& script, const std::string& baseDir, double voxelSize,
+                  Interrupter* interrupter, const Progress& progress) {
+    GridPtr start = makeStartGrid(script, baseDir, voxelSize, interrupter);
+    ExactReference::StartFunction exact = exactStart(script, start);
+    AdvectOptions options;
+    options.interrupter = interrupter;
+    Sculptor sculptor(std::move(start), options);
+    History history;
+    applyStrokes(sculptor, script.strokes, progress, {}, &history);
+    return Shape(sculptor.gridPtr(), std::move(exact), std::move(history));
+}
+
+namespace {
+
+// The document of a start: a VDB start keeps its file's voxel size, which the script then
+// says, so that it replays (the modeler's Document::open does the same).
+Document startDocument(StrokeScript script, const std::string& baseDir, Interrupter* interrupter) {
+    GridPtr start = makeStartGrid(script, baseDir, 0.0, interrupter);
+    if (script.start.kind == StartShape::Kind::Vdb) {
+        script.grid.voxelSize = start->voxelSize()[0];
+        script.grid.halfWidth = halfWidthOf(*start);
+        script.grid.voxelSizeGiven = script.grid.halfWidthGiven = true;
+    }
+    return Document(std::move(script), baseDir, {}, std::move(start), interrupter);
+}
+
+} // namespace
+
+Session::Session(StrokeScript script, const std::string& baseDir, Interrupter* interrupter)
+    : baseDir_(baseDir), document_(startDocument(std::move(script), baseDir, interrupter)) {
+    // The start as the document made it: a second grid only for a sampled start.
+    const StrokeScript& s = document_.script();
+    start_ = s.start.kind == StartShape::Kind::Sphere ? exactStart(s, nullptr)
+                                                      : exactStart(s, document_.grid().deepCopy());
+}
+
+void Session::apply(const std::vector<Stroke>& strokes, Interrupter* interrupter,
+                    const Progress& progress) {
+    std::size_t total = 0, done = 0;
+    for (const Stroke& s : strokes)
+        total += segmentCount(s, document_.grid().voxelSize()[0]);
+    std::vector<History> applied;
+    document_.setInterrupter(interrupter);
+    try {
+        document_.beginEdit();
+        for (const Stroke& stroke : strokes) {
+            applied.emplace_back();
+            document_.applyStroke(stroke, [&](const SegmentReport& r) {
+                applied.back().push_back(r.deformation);
+                if (progress) progress(++done, total);
+            });
+        }
+        document_.endEdit();
+    } catch (const Cancelled&) {
+        // The document put the grid back to where the edit began (Document::cancellable):
+        // every stroke of this call is taken back.
+        document_.setInterrupter(nullptr);
+        throw;
+    } catch (...) {
+        // Any other failure: the strokes finished before it are one edit, taken back.
+        const bool partly = applied.size() > 1;
+        document_.endEdit();
+        if (partly) document_.undo();
+        document_.setInterrupter(nullptr);
+        throw;
+    }
+    document_.setInterrupter(nullptr);
+    history_.insert(history_.end(), applied.begin(), applied.end());
+    undone_.clear();
+}
+
+bool Session::undo() {
+    if (!document_.canUndo()) return false;
+    const std::size_t before = document_.script().strokes.size();
+    document_.undo();
+    const std::size_t after = document_.script().strokes.size();
+    undone_.insert(undone_.end(), history_.begin() + std::ptrdiff_t(after),
+                   history_.begin() + std::ptrdiff_t(before));
+    history_.resize(after);
+    return true;
+}
+
+bool Session::redo() {
+    if (!document_.canRedo()) return false;
+    const std::size_t before = document_.script().strokes.size();
+    document_.redo();
+    const std::size_t added = document_.script().strokes.size() - before;
+    // The last undone step is the one redone: its strokes are at the end of undone_.
+    const auto from = undone_.end() - std::ptrdiff_t(added);
+    history_.insert(history_.end(), from, undone_.end());
+    undone_.erase(from, undone_.end());
+    return true;
+}
+
+StrokeScript Session::script() const {
+    return withAbsoluteFiles(document_.script(), baseDir_);
+}
+
+History Session::allHistory() const {
+    History all;
+    for (const History& h : history_)
+        all.insert(all.end(), h.begin(), h.end());
+    return all;
+}
+
+Shape Session::shape() const {
+    return Shape(document_.grid().deepCopy(), start_, allHistory());
+}
+
+Shape Session::view() const {
+    // Not owned: the session's grid, for as long as the call that asked for it.
+    return Shape(std::shared_ptr<const Grid>(std::shared_ptr<const Grid>(), &document_.grid()),
+                 start_, allHistory());
+}
+
+} // namespace sweepers::python

@@ -1,0 +1,338 @@
+"""`import sweepers` from Debian's python3, checked against sweepers-cli and pyopenvdb.
+
+Run by CTest (python.module) with PYTHONPATH at the build's python/ directory and
+SWEEPERS_CLI and SWEEPERS_DATA set.
+"""
+import csv
+import json
+import os
+import signal
+import struct
+import subprocess
+import threading
+import time
+
+import numpy as np
+import pyopenvdb as vdb
+import pytest
+
+import sweepers
+
+CLI = os.environ["SWEEPERS_CLI"]
+DATA = os.environ["SWEEPERS_DATA"]
+TWISTED = os.path.join(DATA, "twisted_limb.json")
+RIGID = os.path.join(DATA, "studies", "rigid_motion.json")
+
+
+# The CLI without what this interpreter needed to load a sanitized module (LD_PRELOAD of
+# the sanitizers' runtime, which the CLI links itself).
+CLI_ENV = {k: v for k, v in os.environ.items() if k != "LD_PRELOAD"}
+
+
+def cli(*args, check=True):
+    return subprocess.run([CLI, *args], capture_output=True, text=True, check=check,
+                          env=CLI_ENV)
+
+
+def voxels(grid):
+    """Every active voxel of a pyopenvdb grid: {(i, j, k): value}."""
+    out = {}
+    for it in grid.citerOnValues():
+        if it.count == 1:
+            out[it.min] = it.value
+    return out
+
+
+def read_ply(path):
+    """The vertices and triangles of a binary little-endian PLY of float x y z (and more
+    float properties) and uchar-counted int faces, as the CLI writes it."""
+    data = open(path, "rb").read()
+    header, body = data.split(b"end_header\n", 1)
+    lines = header.decode().splitlines()
+    start = next(i for i, l in enumerate(lines) if l.startswith("element vertex"))
+    count = int(lines[start].split()[2])
+    props = 0
+    for l in lines[start + 1:]:
+        if not l.startswith("property"):
+            break
+        props += 1
+    faces = int(next(l for l in lines if l.startswith("element face")).split()[2])
+    v = np.frombuffer(body, dtype="<f4", count=count * props).reshape(count, props)[:, :3]
+    at, tris = count * props * 4, []
+    for _ in range(faces):
+        assert body[at] == 3
+        tris.append(struct.unpack_from("<3i", body, at + 1))
+        at += 13
+    return v, np.array(tris, dtype=np.int32)
+
+
+@pytest.fixture(scope="module")
+def twisted(tmp_path_factory):
+    d = tmp_path_factory.mktemp("twisted")
+    out = cli("apply", TWISTED, "-o", str(d / "t.vdb"), "--mesh", str(d / "t.ply"), "--json")
+    return sweepers.apply(TWISTED), json.loads(out.stdout), d
+
+
+def test_version_is_the_programs():
+    assert cli("--version").stdout.split()[-1] == sweepers.__version__
+
+
+def test_apply_gives_what_the_cli_writes(twisted):
+    shape, report, d = twisted
+    assert shape.volume == pytest.approx(report["volume"], rel=1e-12)
+    assert shape.topology == {"euler_characteristic": 2, "genus": 0, "components": 1}
+    vertices, triangles = shape.mesh()
+    assert vertices.dtype == np.float32 and vertices.shape[1] == 3
+    assert triangles.dtype == np.int32 and triangles.shape[1] == 3
+    ply_vertices, ply_triangles = read_ply(d / "t.ply")
+    assert np.array_equal(vertices, ply_vertices)  # vertex for vertex
+    assert np.array_equal(triangles, ply_triangles)
+    grid = shape.to_pyopenvdb()
+    written = vdb.read(str(d / "t.vdb"), "surface")
+    assert grid.gridClass == written.gridClass and grid.background == written.background
+    assert voxels(grid) == voxels(written)  # voxel for voxel
+    assert len(voxels(grid)) == report["active_voxels"]
+
+
+def test_save_writes_what_pyopenvdb_and_the_cli_read(twisted, tmp_path):
+    shape, _, d = twisted
+    shape.save(tmp_path / "s.vdb")
+    shape.save(str(tmp_path / "s.ply"))
+    assert voxels(vdb.read(str(tmp_path / "s.vdb"), "surface")) == voxels(
+        vdb.read(str(d / "t.vdb"), "surface"))
+    assert np.array_equal(read_ply(tmp_path / "s.ply")[0], read_ply(d / "t.ply")[0])
+    info = json.loads(cli("info", str(tmp_path / "s.vdb"), "--json").stdout)
+    assert info["volume"] == pytest.approx(shape.volume, rel=1e-12)
+
+
+def test_a_script_as_a_dict_or_a_json_string_is_the_file(twisted):
+    shape = twisted[0]
+    text = open(RIGID).read()
+    a = sweepers.apply(json.loads(text))
+    b = sweepers.apply(text)
+    c = sweepers.apply(RIGID, voxel_size=1 / 64)
+    assert a.volume == b.volume == c.volume
+    assert voxels(a.to_pyopenvdb()) == voxels(c.to_pyopenvdb())
+    assert c.voxel_size == 1 / 64
+    assert shape.voxel_size == json.load(open(TWISTED))["grid"]["voxel_size"]
+
+
+STROKES = [
+    {"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3,
+                                 "path": [{"t": [0, 0.9, 0]}, {"t": [0, 1.3, 0.1]}]}]},
+    {"type": "swirl", "at": [0, 0, 0.9], "move": [0, 0.2, 0.3], "radius": 0.35},
+    {"type": "inflate", "at": [0.6, 0.6, 0], "radius": 0.3},
+    {"type": "sweep", "mirror": "x",
+     "tools": [{"shape": "ball", "size": 0.25, "falloff": 0.25,
+                "path": [{"t": [0.5, -0.7, 0]}, {"t": [0.7, -0.9, 0]}]}]},
+    {"type": "pinch", "at": [0, 0, 0], "axis": [0, 1, 0], "size": 1.25, "falloff": 0.4,
+     "open": 0.3},
+    {"type": "swirl", "at": [-0.9, 0, 0], "move": [-0.2, 0, 0], "radius": 0.3},
+    {"type": "inflate", "at": [0, 0.4, -0.9], "radius": 0.25},
+    {"type": "sweep", "tools": [{"shape": "ellipsoid", "size": [0.3, 0.2, 0.2],
+                                 "falloff": 0.2,
+                                 "path": [{"t": [0, 0, -1]}, {"t": [0.1, 0.2, -1.3]}]}]},
+    {"type": "swirl", "at": [0.9, 0, 0], "move": [0.1, 0.1, 0], "radius": 0.3,
+     "ring": "convolution"},
+    {"type": "sweep", "tools": [{"shape": "ball", "size": 0.2, "falloff": 0.2,
+                                 "path": [{"t": [-0.5, 0.7, 0.3]}, {"t": [-0.6, 0.9, 0.4]}]}]},
+]
+
+
+@pytest.fixture(scope="module")
+def session():
+    s = sweepers.Sculptor(voxel_size=1 / 32)
+    for stroke in STROKES:
+        s.apply(stroke)
+    return s
+
+
+def test_a_sessions_script_replays_to_the_same_grid(session, tmp_path):
+    script = session.script()
+    assert [s["type"] for s in script["strokes"]] == [s["type"] for s in STROKES]
+    (tmp_path / "session.json").write_text(json.dumps(script))
+    cli("apply", str(tmp_path / "session.json"), "-o", str(tmp_path / "replay.vdb"))
+    replay = voxels(vdb.read(str(tmp_path / "replay.vdb"), "surface"))
+    assert voxels(session.to_pyopenvdb()) == replay
+
+
+def test_undo_then_redo_gives_the_same_grid(session):
+    before = voxels(session.to_pyopenvdb())
+    volume = session.volume
+    assert session.undo() and session.undo()
+    assert len(session.script()["strokes"]) == len(STROKES) - 2
+    assert session.volume != volume
+    assert session.redo() and session.redo() and not session.redo()
+    assert voxels(session.to_pyopenvdb()) == before
+    assert len(session.script()["strokes"]) == len(STROKES)
+
+
+def test_a_list_of_strokes_is_one_undo_step():
+    s = sweepers.Sculptor(voxel_size=1 / 16)
+    start = s.volume
+    s.apply(STROKES[:3])
+    assert s.volume != start
+    assert s.undo() and not s.can_undo
+    assert s.volume == start
+
+
+def test_a_sculptor_starts_from_a_vdb_or_a_mesh(twisted):
+    shape, _, d = twisted
+    from_vdb = sweepers.Sculptor(d / "t.vdb")
+    assert from_vdb.voxel_size == shape.voxel_size
+    assert voxels(from_vdb.to_pyopenvdb()) == voxels(shape.to_pyopenvdb())
+    from_mesh = sweepers.Sculptor(str(d / "t.ply"), voxel_size=shape.voxel_size)
+    assert from_mesh.volume == pytest.approx(shape.volume, rel=0.01)
+    assert from_mesh.script()["start"]["mesh"] == str(d / "t.ply")
+
+
+def test_exact_distance_is_the_moved_sphere():
+    # rigid_motion.json carries a sphere of radius 0.5 rigidly, inside a tool that holds it
+    # whole: its exact shape is the sphere at the path's last placement.
+    shape = sweepers.apply(RIGID, voxel_size=1 / 32)
+    rng = np.random.default_rng(7)
+    directions = rng.normal(size=(1000, 3))
+    directions /= np.linalg.norm(directions, axis=1)[:, None]
+    center = np.array([0.45, 0.2, -0.1])
+    radii = rng.uniform(0.45, 0.55, size=1000)
+    points = center + directions * radii[:, None]
+    exact = shape.exact_distance(points)
+    assert exact.shape == (1000,)
+    assert np.max(np.abs(exact - (radii - 0.5))) < 1e-9
+    # The grid is within a fraction of a voxel of it.
+    assert np.sqrt(np.mean((shape.sample(points) - exact) ** 2)) < 0.1 / 32
+
+
+def test_sample_is_the_grid_pyopenvdb_reads(twisted):
+    shape = twisted[0]
+    grid = shape.to_pyopenvdb()
+    acc = grid.getConstAccessor()
+    rng = np.random.default_rng(3)
+    lo, hi = np.array(grid.evalActiveVoxelBoundingBox())
+    h = shape.voxel_size
+    points = rng.uniform(lo * h - 0.1, hi * h + 0.1, size=(1000, 3))
+    sampled = shape.sample(points)
+    # Trilinear interpolation of the voxels, here by hand.
+    expected = []
+    for p in points:
+        x = np.array(grid.transform.worldToIndex(tuple(p)))
+        base = np.floor(x).astype(int)
+        f = x - base
+        value = 0.0
+        for corner in range(8):
+            o = np.array([(corner >> 2) & 1, (corner >> 1) & 1, corner & 1])
+            w = np.prod(np.where(o == 1, f, 1 - f))
+            value += w * acc.getValue(tuple(int(c) for c in base + o))
+        expected.append(value)
+    assert np.max(np.abs(sampled - np.array(expected))) < 1e-6
+
+
+def test_to_vdb_bytes_is_what_pyopenvdb_unpickles(twisted):
+    shape = twisted[0]
+    data = shape.to_vdb_bytes()
+    assert isinstance(data, bytes) and len(data) > 1000
+    grid = vdb.FloatGrid()
+    grid.__setstate__(({}, data))
+    assert voxels(grid) == voxels(shape.to_pyopenvdb())
+
+
+def test_a_study_gives_the_clis_table(tmp_path):
+    rows = sweepers.study([RIGID, TWISTED], ["1/16", 1 / 32], ["trilinear", "cubic"],
+                          directory=tmp_path / "py")
+    import pandas
+    assert isinstance(rows, pandas.DataFrame) and len(rows) == 8
+    cli("study", RIGID, TWISTED, "-o", str(tmp_path / "cli"), "--voxel-sizes", "1/16,1/32",
+        "--variants", "trilinear,cubic", "-q")
+    table = list(csv.DictReader(open(tmp_path / "cli" / "study.csv")))
+    for row, (_, frame) in zip(table, rows.iterrows()):
+        assert (row["script"], row["variant"]) == (frame["script"], frame["variant"])
+        assert float(row["err_rms"]) == pytest.approx(frame["err_rms"], rel=1e-6)
+        assert int(row["active_voxels"]) == frame["active_voxels"]
+    # Without a directory: a temporary one, removed.
+    again = sweepers.study(RIGID, [1 / 16])
+    assert list(again["err_rms"]) == [rows["err_rms"][0]]
+
+
+def test_bad_input_raises_with_the_clis_message(tmp_path):
+    bad = {"sweepers": 1, "strokes": [{"type": "smudge"}]}
+    (tmp_path / "bad.json").write_text(json.dumps(bad))
+    said = cli("apply", str(tmp_path / "bad.json"), "-o", str(tmp_path / "x.vdb"),
+               check=False).stderr.strip()
+    with pytest.raises(ValueError) as e:
+        sweepers.apply(str(tmp_path / "bad.json"))
+    assert "sweepers-cli: " + str(e.value) == said
+    with pytest.raises(ValueError, match="unknown stroke type"):
+        sweepers.apply(bad)
+    with pytest.raises(ValueError, match="voxel_size must be a positive number"):
+        sweepers.apply(RIGID, voxel_size=float("nan"))
+    missing = str(tmp_path / "missing.json")
+    said = cli("apply", missing, "-o", str(tmp_path / "x.vdb"), check=False).stderr.strip()
+    with pytest.raises(OSError) as e:
+        sweepers.apply(missing)
+    assert "sweepers-cli: " + str(e.value) == said
+    with pytest.raises(ValueError):
+        sweepers.apply({"sweepers": 1, "strokes": {"type": "sweep"}})  # not a list
+    with pytest.raises(ValueError):
+        sweepers.Sculptor().apply({"type": "sweep", "tools": "ball"})
+    with pytest.raises(ValueError, match="n x 3"):
+        sweepers.apply(RIGID).sample(np.zeros((4, 2)))
+    with pytest.raises(TypeError):
+        sweepers.apply(42)
+
+
+def test_progress_reaches_the_end_and_its_errors_stop_the_work():
+    seen = []
+    sweepers.apply(TWISTED, voxel_size=1 / 32, progress=lambda d, t: seen.append((d, t)))
+    assert seen and seen[-1][0] == seen[-1][1] and [d for d, _ in seen] == list(
+        range(1, len(seen) + 1))
+
+    def fail(done, total):
+        raise RuntimeError("stop here")
+
+    s = sweepers.Sculptor(voxel_size=1 / 32)
+    with pytest.raises(RuntimeError, match="stop here"):
+        s.apply(STROKES[:2], progress=fail)
+    assert s.script()["strokes"] == [] and not s.can_undo
+
+
+PINCH = {"type": "pinch", "at": [0, 0, 0], "axis": [0, 1, 0], "size": 1.25, "falloff": 0.4,
+         "open": 0.3}
+
+
+def test_ctrl_c_cancels_and_leaves_the_sculptor_as_it_was():
+    s = sweepers.Sculptor(voxel_size=1 / 64)
+    s.apply(STROKES[0])
+    before, volume = voxels(s.to_pyopenvdb()), s.volume
+    # SIGINT, as Ctrl-C in a terminal or a notebook's interrupt sends it, from another thread
+    # while the engine works (a pinch at 1/64 takes about a second, the sanitizers' build
+    # several): no Python code runs in between that would see it.
+    timer = threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    started = time.monotonic()
+    with pytest.raises(KeyboardInterrupt):
+        s.apply([STROKES[1], PINCH, STROKES[2]])
+    timer.join()
+    assert time.monotonic() - started < 10
+    assert s.volume == volume and voxels(s.to_pyopenvdb()) == before
+    assert len(s.script()["strokes"]) == 1 and s.can_undo and not s.can_redo
+    # Python's own handler is back.
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+    # The same Sculptor goes on.
+    s.apply(PINCH)
+    assert s.topology["genus"] == 1
+
+
+def test_the_engine_releases_the_gil():
+    ticks = []
+    done = threading.Event()
+
+    def work():
+        sweepers.apply(TWISTED, voxel_size=1 / 64)
+        done.set()
+
+    t = threading.Thread(target=work)
+    t.start()
+    while not done.is_set():
+        ticks.append(1)  # runs only while the apply does not hold the GIL
+    t.join()
+    assert len(ticks) > 1000
