@@ -165,6 +165,7 @@ ChildRead readInChild(const char* kind, const std::string& path, const std::stri
     }
     const double bytes = limits.bytes > 0 ? limits.bytes : readerMemory(path);
     std::vector<const char*> argv;
+    argv.reserve(command.size() + 5);
     for (const std::string& a : command)
         argv.push_back(a.c_str());
     for (const char* a : {kMarker, kind, path.c_str(), gridName.c_str()})

@@ -201,18 +201,24 @@ double voxelSizeFrom(const py::object& value) {
     return h;
 }
 
-std::vector<Eigen::Vector3d>
-pointsFrom(const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
+using Points = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// A shape's values at an n x 3 array of points (`at` is Shape::sample or exactDistance),
+// computed without the GIL.
+py::array_t<double> valuesAt(const Shape& shape, const Points& points,
+                             std::vector<double> (Shape::*at)(const std::vector<Eigen::Vector3d>&)
+                                 const) {
     if (points.ndim() != 2 || points.shape(1) != 3)
         throw std::invalid_argument("points: an n x 3 array");
-    std::vector<Eigen::Vector3d> out(std::size_t(points.shape(0)));
-    const auto p = points.unchecked<2>();
+    std::vector<Eigen::Vector3d> p(std::size_t(points.shape(0)));
+    const auto in = points.unchecked<2>();
     for (py::ssize_t i = 0; i < points.shape(0); ++i)
-        out[std::size_t(i)] = {p(i, 0), p(i, 1), p(i, 2)};
-    return out;
-}
-
-py::array_t<double> arrayOf(const std::vector<double>& values) {
+        p[std::size_t(i)] = {in(i, 0), in(i, 1), in(i, 2)};
+    std::vector<double> values;
+    {
+        py::gil_scoped_release release;
+        values = (shape.*at)(p);
+    }
     py::array_t<double> out(py::ssize_t(values.size()));
     std::copy(values.begin(), values.end(), out.mutable_data());
     return out;
@@ -285,32 +291,16 @@ template <typename Class, typename Of> void addShapeMethods(Class& cls, const Of
             "that `sweepers-cli apply --mesh` exports.")
         .def(
             "sample",
-            [of](const typename Class::type& s,
-                 const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
-                const std::vector<Eigen::Vector3d> p = pointsFrom(points);
-                const Shape& shape = of(s);
-                std::vector<double> values;
-                {
-                    py::gil_scoped_release release;
-                    values = shape.sample(p);
-                }
-                return arrayOf(values);
+            [of](const typename Class::type& s, const Points& points) {
+                return valuesAt(of(s), points, &Shape::sample);
             },
             py::arg("points"),
             "The grid's signed distance (trilinear, negative inside) at an n x 3 array of "
             "points.")
         .def(
             "exact_distance",
-            [of](const typename Class::type& s,
-                 const py::array_t<double, py::array::c_style | py::array::forcecast>& points) {
-                const std::vector<Eigen::Vector3d> p = pointsFrom(points);
-                const Shape& shape = of(s);
-                std::vector<double> values;
-                {
-                    py::gil_scoped_release release;
-                    values = shape.exactDistance(p);
-                }
-                return arrayOf(values);
+            [of](const typename Class::type& s, const Points& points) {
+                return valuesAt(of(s), points, &Shape::exactDistance);
             },
             py::arg("points"),
             "The exact shape's implicit function at an n x 3 array of points: the start "
@@ -475,6 +465,8 @@ PYBIND11_MODULE(sweepers, m) {
     }
 
     // The engine's errors as Python's, with the message the CLI prints.
+    // pybind11's translators take the exception by value.
+    // NOLINTNEXTLINE(performance-unnecessary-value-param)
     py::register_exception_translator([](std::exception_ptr p) {
         try {
             if (p) std::rethrow_exception(p);

@@ -30,7 +30,7 @@ two=("$data/studies/rigid_motion.json" "$data/twisted_limb.json")
 sizes=(--voxel-sizes 1/16,1/32 --variants trilinear,cubic)
 "$cli" study "${two[@]}" -o "$tmp/local" "${sizes[@]}" -q
 "$cli" study "${two[@]}" -o "$tmp/slurm" "${sizes[@]}" --slurm --wait --max-running 2 \
-  --sbatch-arg=--comment=sweepers-test 2>"$tmp/err" || fail "--slurm --wait: $(cat "$tmp/err")"
+  --partition test --sbatch-arg=--comment=sweepers-test 2>"$tmp/err" || fail "--slurm --wait: $(cat "$tmp/err")"
 same "$tmp/local" "$tmp/slurm"
 grep -q "8 runs (0 reused from before, 0 failed)" "$tmp/err" || fail "summary: $(cat "$tmp/err")"
 "$py" - "$tmp/slurm" <<'PY'
@@ -55,6 +55,7 @@ for script in ("rigid_motion", "twisted_limb"):
 runs = open(f"{d}/slurm/runs.sbatch").read()
 assert re.search(r"^#SBATCH --array=1,2,3,5,6,7%2$", runs, re.M), runs
 assert "#SBATCH --comment=sweepers-test" in runs and "--cpus-per-task=1" in runs, runs
+assert "#SBATCH --partition=test" in runs, runs
 merge = open(f"{d}/slurm/merge.sbatch").read()
 assert "--merge" in merge, merge
 logs = os.listdir(f"{d}/slurm/logs")
