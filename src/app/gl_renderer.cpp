@@ -93,6 +93,26 @@ std::string findShaderDir(const std::string& argv0) {
                              " or " + places[1].string());
 }
 
+const char* lookName(SurfaceLook look) {
+    switch (look) {
+    case SurfaceLook::Clay:
+        return "clay";
+    case SurfaceLook::Glossy:
+        return "glossy";
+    case SurfaceLook::RedWax:
+        return "red-wax";
+    case SurfaceLook::Normals:
+        return "normals";
+    }
+    return "";
+}
+
+std::optional<SurfaceLook> parseLook(const std::string& name) {
+    for (const SurfaceLook look : kSurfaceLooks)
+        if (name == lookName(look)) return look;
+    return std::nullopt;
+}
+
 GlRenderer::GlRenderer(const std::string& shaderDir) {
     clay_ = program(shaderDir, "clay");
     flat_ = program(shaderDir, "flat");
@@ -250,6 +270,7 @@ void GlRenderer::draw(const glm::dmat4& view, const glm::dmat4& projection, bool
     setMatrix(clay_, "viewProjection", vp);
     setMatrix(clay_, "view", v);
     glUniform3f(glGetUniformLocation(clay_, "baseColor"), 0.78f, 0.62f, 0.52f);
+    glUniform1i(glGetUniformLocation(clay_, "look"), int(look_));
     glEnable(GL_POLYGON_OFFSET_FILL);
     glPolygonOffset(1.0f, 1.0f);
     for (const auto& [k, m] : bricks_) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,16 @@ struct ToolOverlay {
     std::vector<glm::vec3> lines;
 };
 
+// How the surface looks (shaders/clay.frag): the lit clay, or a matcap (a colour per
+// direction the surface faces the camera, by sphere mapping) that reads form without
+// lights: a glossy glaze, red wax, or the normals as colours.
+enum class SurfaceLook { Clay, Glossy, RedWax, Normals };
+inline constexpr SurfaceLook kSurfaceLooks[] = {SurfaceLook::Clay, SurfaceLook::Glossy,
+                                                SurfaceLook::RedWax, SurfaceLook::Normals};
+// clay, glossy, red-wax, normals.
+const char* lookName(SurfaceLook look);
+std::optional<SurfaceLook> parseLook(const std::string& name);
+
 class GlRenderer {
   public:
     // Compiles the shaders found in `shaderDir`; throws with the compiler's log on failure.
@@ -34,6 +45,8 @@ class GlRenderer {
     void update(const SurfaceMesher& mesher, const MeshChanges& changes);
     void draw(const glm::dmat4& view, const glm::dmat4& projection, bool wireframe,
               const ToolOverlay& tool, double groundY);
+    void setLook(SurfaceLook look) { look_ = look; }
+    SurfaceLook look() const { return look_; }
 
     std::size_t bricks() const { return bricks_.size(); }
     std::size_t uploadedBricksLastUpdate() const { return lastUploads_; }
@@ -51,6 +64,7 @@ class GlRenderer {
     GpuMesh sphere_, grid_, lines_;
     int gridLines_ = 0;
     std::size_t lastUploads_ = 0;
+    SurfaceLook look_ = SurfaceLook::Clay;
 };
 
 // Where the shaders are: next to the binary (shaders/ or ../share/sweepers/shaders, where

@@ -41,6 +41,10 @@ static int run(int argc, char** argv) {
     app.add_option("--save-frame", o.saveFrame,
                    "write the frame the timeline shows (.vdb, or a mesh) when the window closes");
     app.add_flag("--hide-ui", o.hideUi, "draw no panels");
+    app.add_option("--look", o.look,
+                   "how the surface looks: clay (lit, the default) or a matcap: glossy, "
+                   "red-wax, normals")
+        ->check(CLI::IsMember({"clay", "glossy", "red-wax", "normals"}));
     app.add_flag("--latency-report", o.latencyReport,
                  "print stroke latency (drag event to mesh on screen) by stage at exit");
     app.add_option("--latency-csv", o.latencyCsv,

@@ -71,6 +71,7 @@ class Modeler {
         : batch_(!o.replayInput.empty() || !o.screenshot.empty() || !o.recordFrames.empty()),
           ctl_(batch_ && !o.replayLive), opt_(o), win_(w) {
         renderer_ = std::make_unique<GlRenderer>(findShaderDir(o.argv0));
+        if (const auto look = parseLook(o.look)) renderer_->setLook(*look);
         ctl_.setIdle([this] { takeMesh(); });
         std::snprintf(path_, sizeof path_, "%s", o.open.empty() ? "untitled.vdb" : o.open.c_str());
         voxelSizeInput_ = float(o.voxelSize);
@@ -753,6 +754,11 @@ class Modeler {
         mustFit("mirror (M)");
         s.mirror = MirrorAxis(mirror);
         ImGui::Checkbox("wireframe (W)", &s.wireframe);
+        // The surface's look: clay, or a matcap that reads form without lights.
+        int look = int(renderer_->look());
+        ImGui::Combo("look", &look, "clay\0glossy\0red wax\0normals\0");
+        mustFit("look");
+        renderer_->setLook(kSurfaceLooks[std::clamp(look, 0, 3)]);
         // Nothing that changes the document while a drag is being sculpted, or while the
         // film of its history plays.
         ImGui::BeginDisabled(ctl_.busy() || sculpting || film_);

@@ -23,6 +23,7 @@ struct ModelerOptions {
     std::string recordFrames;
     std::string saveFrame;      // the frame the timeline shows, written when the window closes
     bool hideUi = false;        // no panels (clean screenshots)
+    std::string look = "clay";  // how the surface looks at first (SurfaceLook's names)
     bool latencyReport = false; // print per-segment latency by stage when the window closes
     std::string latencyCsv;     // ... and write every segment's figures here (ms)
     // Crash safety (app/session.h): where sessions are kept (empty: the default place, and

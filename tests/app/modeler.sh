@@ -18,6 +18,17 @@ run --no-such-option 2>/dev/null || rc=$?
 run --hide-ui --screenshot "$tmp/default.png" --replay-input "$tmp/none.json" --save "$tmp/default.vdb"
 "$py" "$here/check_image.py" centred "$tmp/default.png"
 
+# --- the looks: the lit clay and three matcaps, on the same sphere ----------------------
+for look in clay glossy red-wax normals; do
+  run --hide-ui --look "$look" --screenshot "$tmp/look-$look.png" --replay-input "$tmp/none.json"
+done
+"$py" "$here/check_image.py" looks "$tmp/look-clay.png" "$tmp/look-glossy.png" \
+  "$tmp/look-red-wax.png" "$tmp/look-normals.png"
+cmp -s "$tmp/look-clay.png" "$tmp/default.png" || fail "--look clay is not the default look"
+rc=0
+run --look chrome --hide-ui 2>/dev/null || rc=$?
+[ "$rc" = 2 ] || fail "an unknown look exited $rc, not 2"
+
 # --- the panel at the default window size: every label fits its width, Add clay among the
 #     tools (the modeler reports any item cut off, src/app/modeler.cpp mustFit) -----------
 ASAN_OPTIONS=$app_asan "$app" --voxel-size 0.03125 --screenshot "$tmp/panel.png" \
