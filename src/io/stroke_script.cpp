@@ -38,14 +38,14 @@ const std::pair<const char*, std::vector<const char*>> kScriptFields[] = {
     {"start", {"sphere", "vdb", "mesh", "grid"}},
     {"sphere", {"center", "radius"}},
     {"any stroke", {"duration"}},
-    {"sweep", {"type", "mirror", "tools"}},
+    {"sweep", {"type", "mirror", "tools", "strength"}},
     {"tool", {"shape", "size", "falloff", "path"}},
     {"keyed tool", {"shape", "size", "falloff"}},
     {"placement", {"t", "r", "s"}},
     {"keyed placement", {"time"}},
     {"baked shape", {"vdb", "mesh", "grid", "voxel_size"}},
-    {"swirl", {"type", "at", "move", "radius", "ring", "swirls", "ball"}},
-    {"inflate", {"type", "at", "radius"}},
+    {"swirl", {"type", "at", "move", "radius", "ring", "swirls", "ball", "strength"}},
+    {"inflate", {"type", "at", "radius", "strength"}},
     {"pinch or strangle", {"type", "at", "axis", "size", "falloff", "open"}},
     {"keyframed", {"type", "tool", "keys"}},
     {"slide", {"type", "mirror", "tools", "keys"}},
@@ -243,9 +243,19 @@ ToolSpec readTool(const Reader& r, const json& v, const std::string& at,
     return t;
 }
 
+// A stroke's "strength": a fraction in (0, 1], 1 when not given.
+double readStrength(const Reader& r, const json& v, const std::string& at) {
+    const auto it = v.find("strength");
+    if (it == v.end()) return 1.0;
+    const double s = r.positive(*it, at + "/strength");
+    if (s > 1.0) r.fail(at + "/strength", "expected a fraction, greater than 0 and at most 1");
+    return s;
+}
+
 SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "sweep");
     SweepStroke s;
+    s.strength = readStrength(r, v, at);
     if (auto it = v.find("mirror"); it != v.end()) {
         const std::string m = r.string(*it, at + "/mirror");
         if (m == "x")
@@ -358,6 +368,7 @@ FluidStroke readFluid(const Reader& r, const json& v, const std::string& at) {
 SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "swirl");
     SwirlStroke s;
+    s.strength = readStrength(r, v, at);
     s.at = r.vec3(r.require(v, at, "at"), at + "/at");
     s.move = r.vec3(r.require(v, at, "move"), at + "/move");
     s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
@@ -388,6 +399,7 @@ SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
 InflateStroke readInflate(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "inflate");
     InflateStroke s;
+    s.strength = readStrength(r, v, at);
     s.at = r.vec3(r.require(v, at, "at"), at + "/at");
     s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
     return s;
@@ -779,6 +791,7 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             j["type"] = "sweep";
             if (sw->mirror != MirrorAxis::None) j["mirror"] = mirrorName(sw->mirror);
             j["tools"] = toolsJson(*sw);
+            if (sw->strength != 1.0) j["strength"] = sw->strength;
         } else if (const auto* sr = std::get_if<SwirlStroke>(&stroke)) {
             j["type"] = "swirl";
             j["at"] = vecJson(sr->at);
@@ -787,10 +800,12 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             j["ring"] = sr->ring == SwirlRing::Convolution ? "convolution" : "discrete";
             j["swirls"] = sr->swirls;
             if (sr->ball > 0.0) j["ball"] = sr->ball;
+            if (sr->strength != 1.0) j["strength"] = sr->strength;
         } else if (const auto* in = std::get_if<InflateStroke>(&stroke)) {
             j["type"] = "inflate";
             j["at"] = vecJson(in->at);
             j["radius"] = in->radius;
+            if (in->strength != 1.0) j["strength"] = in->strength;
         } else if (const auto* pinch = std::get_if<PinchStroke>(&stroke)) {
             j = topologyToolJson("pinch", *pinch);
         } else if (const auto* strangle = std::get_if<StrangleStroke>(&stroke)) {

@@ -33,6 +33,16 @@ Sweep toSweep(const SweepStroke& stroke) {
         }
         st.falloff = t.falloff;
         st.path = t.path;
+        // A fraction of the hand's motion: each placement that fraction of the way from the
+        // first along the motion to it, exp(s log(P_k P_0^-1)) P_0 (as 3.12's sub-steps are).
+        if (stroke.strength != 1.0)
+            for (std::size_t k = 1; k < st.path.size(); ++k) {
+                const auto along = placementAlong(t.path.front(), t.path[k], stroke.strength);
+                if (!along)
+                    throw std::invalid_argument("a placement of the stroke has no fraction of "
+                                                "its motion (strength)");
+                st.path[k] = *along;
+            }
         sweep.tools.push_back(std::move(st));
     }
     return sweep;
@@ -41,7 +51,7 @@ Sweep toSweep(const SweepStroke& stroke) {
 SwirlSpec toSwirl(const SwirlStroke& stroke) {
     SwirlSpec s;
     s.at = stroke.at;
-    s.move = stroke.move;
+    s.move = stroke.strength * stroke.move;
     s.radius = stroke.radius;
     s.ring = stroke.ring;
     s.swirls = stroke.swirls;
@@ -118,7 +128,7 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                     parts.push_back(std::make_unique<SwirlSegment>(toSwirl(s)));
             },
             [&](const InflateStroke& s) {
-                parts.push_back(std::make_unique<Inflation>(s.at, s.radius, reach()));
+                parts.push_back(std::make_unique<Inflation>(s.at, s.strength * s.radius, reach()));
             },
             [&](const PinchStroke& s) { parts = planPinch(s, grid.voxelSize()[0]); },
             [&](const StrangleStroke& s) { parts = planStrangle(s, grid.voxelSize()[0]); },

@@ -76,9 +76,12 @@ struct ToolSpec {
     std::shared_ptr<const ToolShape> baked;
 };
 
+// A stroke's strength (0, 1]: the fraction of the hand's motion a sweep applies, of a
+// swirl's move, of an inflation's radius. 1 applies them as they are.
 struct SweepStroke {
     MirrorAxis mirror = MirrorAxis::None;
     std::vector<ToolSpec> tools;
+    double strength = 1.0;
 };
 
 struct SwirlStroke {
@@ -88,11 +91,13 @@ struct SwirlStroke {
     SwirlRing ring = SwirlRing::Discrete;
     int swirls = 8;
     double ball = 0.0; // > 0: star-shaped swirl carrying a ball of this radius (4.19)
+    double strength = 1.0;
 };
 
 struct InflateStroke {
     Eigen::Vector3d at = Eigen::Vector3d::Zero();
     double radius = 0.1;
+    double strength = 1.0;
 };
 
 struct PinchStroke : PinchSpec {};

@@ -186,6 +186,56 @@ def test_a_sculptor_starts_from_a_vdb_or_a_mesh(twisted):
     assert from_mesh.script()["start"]["mesh"] == str(d / "t.ply")
 
 
+def grab(strength=None, stroke="sweep"):
+    """A unit sphere at 1/32 with the top grabbed 0.4 up (or a swirl or an inflation there)."""
+    strokes = {
+        "sweep": {"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3,
+                                             "path": [{"t": [0, 1, 0]}, {"t": [0, 1.4, 0]}]}]},
+        "swirl": {"type": "swirl", "at": [0, 0.9, 0], "move": [0, 0.4, 0], "radius": 0.3},
+        "inflate": {"type": "inflate", "at": [0, 0.9, 0], "radius": 0.3},
+    }
+    stroke = dict(strokes[stroke])
+    if strength is not None:
+        stroke["strength"] = strength
+    return sweepers.apply({"sweepers": 1, "grid": {"voxel_size": 1 / 32},
+                           "start": {"sphere": {"center": [0, 0, 0], "radius": 1}},
+                           "strokes": [stroke]})
+
+
+def top(shape):
+    """The highest point of the surface on the y axis (where the grid crosses zero)."""
+    ys = np.linspace(0.5, 2.0, 3001)
+    d = shape.sample(np.stack([np.zeros_like(ys), ys, np.zeros_like(ys)], axis=1))
+    k = np.nonzero(d > 0)[0][0]  # the first sample outside, going up
+    return ys[k - 1] + (ys[k] - ys[k - 1]) * (-d[k - 1]) / (d[k] - d[k - 1])
+
+
+def test_a_grab_of_strength_half_moves_the_surface_half_as_far():
+    start = sweepers.Sculptor(voxel_size=1 / 32)
+    full, half = grab(), grab(0.5)
+    moved_full, moved_half = top(full) - top(start), top(half) - top(start)
+    print(f"the top moved {moved_full:.4f} at strength 1, {moved_half:.4f} at 0.5")
+    assert moved_full > 0.3
+    assert abs(moved_half - moved_full / 2) < 1 / 32  # within a voxel
+    # Strength 1 is the stroke as it was, voxel for voxel.
+    assert voxels(grab(1.0).to_pyopenvdb()) == voxels(full.to_pyopenvdb())
+    # A swirl's move and an inflation's radius take it too.
+    for kind in ("swirl", "inflate"):
+        assert top(grab(0.5, kind)) - top(start) < 0.8 * (top(grab(None, kind)) - top(start))
+
+
+def test_a_strength_is_kept_in_the_script_and_refused_outside_its_range():
+    s = sweepers.Sculptor(voxel_size=1 / 16)
+    s.apply({"type": "swirl", "at": [0, 0.9, 0], "move": [0, 0.3, 0], "radius": 0.3,
+             "strength": 0.25})
+    assert s.script()["strokes"][0]["strength"] == 0.25
+    with pytest.raises(ValueError, match="strength"):
+        s.apply({"type": "inflate", "at": [0, 1, 0], "radius": 0.2, "strength": 1.5})
+    with pytest.raises(ValueError, match="strength"):
+        s.apply({"type": "pinch", "at": [0, 0, 0], "axis": [0, 1, 0], "size": 1.25,
+                 "falloff": 0.4, "open": 0.3, "strength": 0.5})
+
+
 def test_exact_distance_is_the_moved_sphere():
     # rigid_motion.json carries a sphere of radius 0.5 rigidly, inside a tool that holds it
     # whole: its exact shape is the sphere at the path's last placement.
