@@ -38,7 +38,8 @@ const std::pair<const char*, std::vector<const char*>> kScriptFields[] = {
     {"start", {"sphere", "vdb", "mesh", "grid"}},
     {"sphere", {"center", "radius"}},
     {"any stroke", {"duration"}},
-    {"sweep", {"type", "mirror", "tools", "strength"}},
+    {"sweep", {"type", "mirror", "tools", "strength", "radial"}},
+    {"radial", {"axis", "center", "count"}},
     {"tool", {"shape", "size", "falloff", "path"}},
     {"keyed tool", {"shape", "size", "falloff"}},
     {"placement", {"t", "r", "s"}},
@@ -266,6 +267,17 @@ SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
             s.mirror = MirrorAxis::Z;
         else
             r.fail(at + "/mirror", "expected \"x\", \"y\" or \"z\"");
+    }
+    if (auto it = v.find("radial"); it != v.end()) {
+        const std::string where = at + "/radial";
+        r.onlyKeys(*it, where, "radial");
+        s.radial.axis = r.vec3(r.require(*it, where, "axis"), where + "/axis");
+        if (!(s.radial.axis.norm() > 0.0)) r.fail(where + "/axis", "an axis needs a length");
+        s.radial.center = r.vec3(r.require(*it, where, "center"), where + "/center");
+        const json& count = r.require(*it, where, "count");
+        if (!count.is_number_integer() || count.get<long long>() < 1 || count.get<long long>() > 64)
+            r.fail(where + "/count", "expected a whole number from 1 to 64");
+        s.radial.count = count.get<int>();
     }
     const json& tools = r.require(v, at, "tools");
     if (!tools.is_array() || tools.empty())
@@ -792,6 +804,10 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             if (sw->mirror != MirrorAxis::None) j["mirror"] = mirrorName(sw->mirror);
             j["tools"] = toolsJson(*sw);
             if (sw->strength != 1.0) j["strength"] = sw->strength;
+            if (sw->radial.count > 1)
+                j["radial"] = {{"axis", vecJson(sw->radial.axis)},
+                               {"center", vecJson(sw->radial.center)},
+                               {"count", sw->radial.count}};
         } else if (const auto* sr = std::get_if<SwirlStroke>(&stroke)) {
             j["type"] = "swirl";
             j["at"] = vecJson(sr->at);

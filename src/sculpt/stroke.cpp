@@ -1,5 +1,6 @@
 #include "sculpt/stroke.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "deform/inflate.h"
@@ -44,6 +45,31 @@ Sweep toSweep(const SweepStroke& stroke) {
                 st.path[k] = *along;
             }
         sweep.tools.push_back(std::move(st));
+    }
+    // Radial copies: every tool turned about the axis, each copy a simultaneous tool of the
+    // same sweep, blended with the others by the normalized log blend (3.16-3.18) as mirror
+    // copies are (3.3.2). A turned placement T R S stays of that form: A T R S with A a
+    // rotation about the axis is T' (R_A R) S.
+    const RadialSymmetry& radial = stroke.radial;
+    if (radial.count > 1) {
+        const std::size_t originals = sweep.tools.size();
+        for (int k = 1; k < radial.count; ++k) {
+            const double angle = 2.0 * M_PI * k / radial.count;
+            const Eigen::Affine3d turn = Eigen::Translation3d(radial.center) *
+                                         Eigen::AngleAxisd(angle, radial.axis.normalized()) *
+                                         Eigen::Translation3d(-radial.center);
+            for (std::size_t i = 0; i < originals; ++i) {
+                SweptTool copy = sweep.tools[i];
+                for (Placement& p : copy.path) {
+                    const auto turned = placementOf((turn * p.matrix()).matrix());
+                    if (!turned)
+                        throw std::invalid_argument("a radial copy of a placement is not a "
+                                                    "placement");
+                    p = *turned;
+                }
+                sweep.tools.push_back(std::move(copy));
+            }
+        }
     }
     return sweep;
 }

@@ -76,12 +76,21 @@ struct ToolSpec {
     std::shared_ptr<const ToolShape> baked;
 };
 
+// N copies of each tool, turned about the axis through the centre by multiples of 360/N
+// degrees, swept together with it (1: the tool alone).
+struct RadialSymmetry {
+    Eigen::Vector3d axis = Eigen::Vector3d::UnitY();
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
+    int count = 1;
+};
+
 // A stroke's strength (0, 1]: the fraction of the hand's motion a sweep applies, of a
 // swirl's move, of an inflation's radius. 1 applies them as they are.
 struct SweepStroke {
     MirrorAxis mirror = MirrorAxis::None;
     std::vector<ToolSpec> tools;
     double strength = 1.0;
+    RadialSymmetry radial{};
 };
 
 struct SwirlStroke {
