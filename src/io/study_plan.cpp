@@ -132,6 +132,17 @@ json readJsonFile(const std::string& path) {
     }
 }
 
+// What a script's runs are made of: its text and every file it reads.
+std::string scriptDigest(StrokeScript& script, const std::string& text, const std::string& base) {
+    Digest digest;
+    digest.add(text);
+    forEachScriptFile(script, [&](std::string& input) {
+        if (input.empty()) return;
+        digest.add(input).addFile(resolveAgainst(input, base));
+    });
+    return digest.hex();
+}
+
 } // namespace
 
 StudyPlan planStudy(const std::vector<std::string>& scripts, const std::vector<double>& voxelSizes,
@@ -148,14 +159,7 @@ StudyPlan planStudy(const std::vector<std::string>& scripts, const std::vector<d
         StrokeScript script = readStrokeScript(file, &text);
         for (const double h : voxelSizes)
             requireBuildableStart(script, h, force); // the limits apply holds the script to
-        Digest digest;
-        digest.add(text);
-        const std::string base = directoryOf(s.path);
-        forEachScriptFile(script, [&](std::string& input) {
-            if (input.empty()) return;
-            digest.add(input).addFile(resolveAgainst(input, base));
-        });
-        s.digest = digest.hex();
+        s.digest = scriptDigest(script, text, directoryOf(s.path));
         const std::string stem = std::filesystem::path(file).stem().string();
         const int n = ++seen[stem];
         s.name = n == 1 ? stem : stem + "-" + std::to_string(n);
@@ -243,6 +247,9 @@ StudyPlan readStudyPlan(const std::string& dir) {
                 throw bad("run " + run.id + " is not one of a study");
             run.script = script->second;
             run.variant = *variant;
+            // An id names the run's directory under runs/: only the one its fields make.
+            if (run.id != studyRunId(plannedRow(plan, run)))
+                throw bad("run " + run.id + " is not one of a study");
             run.digest = r.at("digest").get<std::string>();
             const json& e = r.at("estimate");
             run.memoryMb = e.at("memory_mb").is_number() ? e.at("memory_mb").get<double>() : 0.0;
@@ -308,12 +315,11 @@ StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run, Interrupt
     std::optional<StudyRun> done;
     try {
         // The script as it is now must be the one planned: a result says what it was made of.
-        const StudyPlan now =
-            planStudy({source.path}, {run.voxelSize}, {run.variant}, plan.dir, plan.force);
-        if (now.scripts.front().digest != source.digest)
+        std::string text;
+        StrokeScript script = readStrokeScript(source.path, &text);
+        if (scriptDigest(script, text, directoryOf(source.path)) != source.digest)
             throw ScriptError(source.path +
                               ": changed since the study was planned (plan the study again)");
-        const StrokeScript script = readStrokeScript(source.path);
         const GridPtr start =
             makeStartGrid(script, directoryOf(source.path), run.voxelSize, interrupter, plan.force);
         done = runStudyCase(start, script.strokes, exactStart(script, start), run.variant,

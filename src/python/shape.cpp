@@ -13,10 +13,13 @@ namespace sweepers::python {
 
 namespace {
 
-// The engine's values at many points, in parallel: `at(i)` for each.
-template <typename At> std::vector<double> forEachPoint(std::size_t n, const At& at) {
+// The engine's values at many points, in parallel: each range of points gets its own
+// evaluator, `make()` (a sampler's accessor caches nodes: one per thread's range, not one
+// per point), called as `at(i)` for each point.
+template <typename Make> std::vector<double> forEachPoint(std::size_t n, const Make& make) {
     std::vector<double> out(n);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 256), [&](const auto& r) {
+        const auto at = make();
         for (std::size_t i = r.begin(); i != r.end(); ++i)
             out[i] = at(i);
     });
@@ -37,10 +40,12 @@ TriangleMesh Shape::mesh() const {
 }
 
 std::vector<double> Shape::sample(const std::vector<Eigen::Vector3d>& points) const {
-    return forEachPoint(points.size(), [&](std::size_t i) {
-        // A sampler per call: its accessor caches nodes and is not shared between threads.
-        const openvdb::tools::GridSampler<Grid, openvdb::tools::BoxSampler> sampler(*grid_);
-        return double(sampler.wsSample(toVdb(points[i])));
+    return forEachPoint(points.size(), [&] {
+        return [&, acc = grid_->getConstAccessor()](std::size_t i) {
+            const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler>
+                sampler(acc, grid_->transform());
+            return double(sampler.wsSample(toVdb(points[i])));
+        };
     });
 }
 
@@ -48,7 +53,8 @@ std::vector<double> Shape::exactDistance(const std::vector<Eigen::Vector3d>& poi
     ExactReference reference(start_);
     for (const auto& d : history_)
         reference.append(d);
-    return forEachPoint(points.size(), [&](std::size_t i) { return reference.value(points[i]); });
+    return forEachPoint(points.size(),
+                        [&] { return [&](std::size_t i) { return reference.value(points[i]); }; });
 }
 
 std::string Shape::vdbBytes() const {

@@ -194,6 +194,12 @@ rc=0
 "$cli" study -o "$tmp/edit" --run edited-trilinear_16 2>"$tmp/err" || rc=$?
 [ "$rc" = 1 ] && grep -q "changed since the study was planned" "$tmp/err" ||
   fail "an edited script ran: $rc $(cat "$tmp/err")"
+# A plan whose run id would name a directory elsewhere is refused, not followed.
+sed -i 's#"id": "edited-trilinear_16"#"id": "../../outside"#' "$tmp/edit/plan.json"
+rc=0
+"$cli" study -o "$tmp/edit" --list 2>"$tmp/err" || rc=$?
+[ "$rc" = 1 ] && grep -q "is not one of a study" "$tmp/err" ||
+  fail "a plan with a run id outside the study: $rc $(cat "$tmp/err")"
 echo "plan, list, run one by one, merge: the same table"
 
 # --- resuming after a SIGKILL ------------------------------------------------------------
