@@ -46,7 +46,8 @@ const std::pair<const char*, std::vector<const char*>> kScriptFields[] = {
     {"keyed placement", {"time"}},
     {"baked shape", {"vdb", "mesh", "grid", "voxel_size"}},
     {"swirl", {"type", "at", "move", "radius", "ring", "swirls", "ball", "strength"}},
-    {"inflate", {"type", "at", "radius", "strength"}},
+    {"inflate", {"type", "at", "radius", "strength", "remove"}},
+    {"smooth", {"type", "tool", "strength"}},
     {"pinch or strangle", {"type", "at", "axis", "size", "falloff", "open"}},
     {"keyframed", {"type", "tool", "keys"}},
     {"slide", {"type", "mirror", "tools", "keys"}},
@@ -203,7 +204,7 @@ void loadTool(const Reader& r, ToolSpec& t, const std::string& at) {
 
 // A tool with its path, or (`keyed`) with the placements keyed elsewhere as its path.
 ToolSpec readTool(const Reader& r, const json& v, const std::string& at,
-                  const std::vector<Placement>* keyed = nullptr) {
+                  const std::vector<Placement>* keyed = nullptr, std::size_t fewest = 2) {
     if (keyed)
         r.onlyKeys(v, at, "keyed tool");
     else
@@ -236,7 +237,9 @@ ToolSpec readTool(const Reader& r, const json& v, const std::string& at,
     } else {
         const json& path = r.require(v, at, "path");
         if (!path.is_array()) r.fail(at + "/path", "expected an array of placements");
-        if (path.size() < 2) r.fail(at + "/path", "a path needs at least two placements");
+        if (path.size() < fewest)
+            r.fail(at + "/path", fewest == 1 ? "a path needs at least one placement"
+                                             : "a path needs at least two placements");
         for (std::size_t i = 0; i < path.size(); ++i)
             t.path.push_back(readPlacement(r, path[i], at + "/path/" + std::to_string(i)));
     }
@@ -414,6 +417,20 @@ InflateStroke readInflate(const Reader& r, const json& v, const std::string& at)
     s.strength = readStrength(r, v, at);
     s.at = r.vec3(r.require(v, at, "at"), at + "/at");
     s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
+    if (auto it = v.find("remove"); it != v.end()) {
+        if (!it->is_boolean()) r.fail(at + "/remove", "expected true or false");
+        s.remove = it->get<bool>();
+    }
+    return s;
+}
+
+// A smooth stroke: a ball and the placements of its dabs.
+SmoothStroke readSmooth(const Reader& r, const json& v, const std::string& at) {
+    r.onlyKeys(v, at, "smooth");
+    SmoothStroke s;
+    s.strength = readStrength(r, v, at);
+    s.tool = readTool(r, r.require(v, at, "tool"), at + "/tool", nullptr, 1);
+    if (s.tool.shape != ToolShapeKind::Ball) r.fail(at + "/tool/shape", "smoothing takes a ball");
     return s;
 }
 
@@ -712,10 +729,12 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
             s.strokes.emplace_back(readFlow(r, v, at));
         else if (type == "fluid")
             s.strokes.emplace_back(readFluid(r, v, at));
+        else if (type == "smooth")
+            s.strokes.emplace_back(readSmooth(r, v, at));
         else
             r.fail(at + "/type", "unknown stroke type \"" + type +
                                      "\" (expected sweep, swirl, inflate, pinch, strangle, "
-                                     "keyframed, slide, flow or fluid)");
+                                     "keyframed, slide, flow, fluid or smooth)");
         if (keyedDuration(s.strokes.back()) > 0.0 && i < s.durations.size() && s.durations[i] > 0.0)
             r.fail(at + "/duration", "a " + type + " stroke lasts until its last key");
     }
@@ -822,6 +841,11 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             j["at"] = vecJson(in->at);
             j["radius"] = in->radius;
             if (in->strength != 1.0) j["strength"] = in->strength;
+            if (in->remove) j["remove"] = true;
+        } else if (const auto* sm = std::get_if<SmoothStroke>(&stroke)) {
+            j["type"] = "smooth";
+            j["tool"] = toolJson(sm->tool, true);
+            if (sm->strength != 1.0) j["strength"] = sm->strength;
         } else if (const auto* pinch = std::get_if<PinchStroke>(&stroke)) {
             j = topologyToolJson("pinch", *pinch);
         } else if (const auto* strangle = std::get_if<StrangleStroke>(&stroke)) {

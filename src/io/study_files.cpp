@@ -242,8 +242,19 @@ void writeStudyPlots(const std::vector<StudyRow>& rows, const std::string& dir) 
             return p.str();
         };
         const std::string of = scripts.size() > 1 ? " (" + scripts[s] + ")" : "";
-        panels << "set xtics (" << tics << ")\n"
-               << "set key bottom right\nset logscale y\n"
+        panels << "set xtics (" << tics << ")\n";
+        if (!std::isfinite(first->error.rms)) {
+            // No exact reference (a history that smooths): the error panels stay empty.
+            panels << "set multiplot next\nset multiplot next\n"
+                   << "unset key\nset logscale y\nset ylabel 'seconds'\n"
+                   << "set title " << quoted("time" + of + ", no exact reference") << "\n"
+                   << series(4) << "\n"
+                   << "set ylabel 'MB'\nset title "
+                   << quoted("peak resident memory of each run" + of) << "\n"
+                   << series(5) << "\n";
+            continue;
+        }
+        panels << "set key bottom right\nset logscale y\n"
                << "set ylabel 'RMS distance to the exact surface'\n"
                << "set title " << quoted("interface error" + of) << "\n"
                << series(2) << ", " << number(e0 / h0, 17) << " * x dashtype 2 linecolor 'gray' "
@@ -432,6 +443,19 @@ nlohmann::json studyJson(const std::vector<StudyRow>& rows) {
     return out;
 }
 
+namespace {
+
+// The columns a run that ran may leave without a value: the orders (no coarser run), and
+// the errors against the exact reference (a history that smooths has none).
+bool notMeasuredIsNan(std::string_view column) {
+    static const std::string_view errors[] = {"err_mean",       "err_rms",    "err_max",
+                                              "err_rms_voxels", "volume_ref", "volume_err"};
+    return column.rfind("order_", 0) == 0 ||
+           std::find(std::begin(errors), std::end(errors), column) != std::end(errors);
+}
+
+} // namespace
+
 StudyRow studyRowFromJson(const nlohmann::json& j, const std::string& where) {
     if (!j.is_object()) throw FileError(where + ": a study row is not a JSON object");
     std::vector<std::string> cells(kColumnCount);
@@ -447,9 +471,8 @@ StudyRow studyRowFromJson(const nlohmann::json& j, const std::string& where) {
             cells[c] = number(it->get<double>(), 17);
         else if (!it->is_null())
             throw FileError(where + ": '" + std::string(kColumns[c]) + "' is " + it->dump());
-        else if (std::string_view(kColumns[c]).rfind("order_", 0) == 0 &&
-                 j.value("failure", "") == "")
-            cells[c] = "nan"; // no coarser run to compare with
+        else if (notMeasuredIsNan(kColumns[c]) && j.value("failure", "") == "")
+            cells[c] = "nan"; // no coarser run to compare with, or no exact reference
     }
     return studyRowFromCells(cells, where);
 }
@@ -525,6 +548,11 @@ std::string studyReport(const std::vector<StudyRow>& rows, const std::vector<Stu
         for (const StudyRow& r : rows)
             if (r.script == script) own.push_back(r);
         if (scripts.size() > 1) out << "## " << script << "\n\n";
+        if (std::any_of(own.begin(), own.end(), [](const StudyRow& r) {
+                return r.failure.empty() && std::isnan(r.error.rms);
+            }))
+            out << "No exact shape stands behind this script: it smooths, and smoothing is not "
+                   "a deformation of space. Its errors are not measured (nan).\n\n";
         out << tableOf(own) << "\n";
     }
     if (!missing.empty()) {

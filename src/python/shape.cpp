@@ -51,8 +51,11 @@ std::vector<double> Shape::sample(const std::vector<Eigen::Vector3d>& points) co
 
 std::vector<double> Shape::exactDistance(const std::vector<Eigen::Vector3d>& points) const {
     ExactReference reference(start_);
-    for (const auto& d : history_)
+    for (const auto& d : history_) {
+        // A smooth dab deforms nothing: its velocity was the surface's own curvature.
+        if (!d) throw std::invalid_argument("the history smooths: no exact shape stands behind it");
         reference.append(d);
+    }
     return forEachPoint(points.size(),
                         [&] { return [&](std::size_t i) { return reference.value(points[i]); }; });
 }

@@ -129,6 +129,16 @@ void FilmPlayer::seek(std::size_t n) {
             ++i_;
             continue;
         }
+        if (std::holds_alternative<SmoothStroke>(stroke)) {
+            // Smoothing is no deformation to take part of the way: frames show the shape
+            // before it until it ends, and it is applied whole then.
+            const double end = start_ + durations_[i_];
+            if (time < end) break;
+            sculptor_.applyStroke(stroke);
+            start_ = end;
+            ++i_;
+            continue;
+        }
         if (!planned_) {
             parts_ = planStroke(sculptor_.grid(), stroke);
             k_ = 0;

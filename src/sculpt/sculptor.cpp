@@ -55,9 +55,33 @@ SegmentReport Sculptor::applySegment(const StepDeformation& deformation) {
     return r;
 }
 
+SegmentReport Sculptor::applySmoothDab(const SmoothBrush& brush) {
+    CurvatureSmoother smoother(*grid_, brush, options_.interrupter);
+    if (recording_) record_.capture(*grid_, smoother.reach());
+    SegmentReport r;
+    const auto t0 = Clock::now();
+    const SmoothStats s = smoother.run();
+    r.seconds = secondsSince(t0);
+    if (meshing_) {
+        const SerialClock clock;
+        r.remeshedLeaves = mesher_.update(*grid_, s.changed);
+        r.meshSeconds = clock.wallSeconds();
+        r.meshSerialSeconds = clock.serialSeconds();
+    }
+    return r;
+}
+
 SegmentReport Sculptor::applyStroke(const Stroke& stroke,
                                     const std::function<void(const SegmentReport&)>& each) {
     SegmentReport last;
+    if (const auto* smooth = std::get_if<SmoothStroke>(&stroke)) {
+        for (std::size_t k = 0; k < smooth->tool.path.size(); ++k) {
+            last = applySmoothDab(smoothDab(*smooth, k));
+            last.segment = k;
+            if (each) each(last);
+        }
+        return last;
+    }
     auto parts = planStroke(*grid_, stroke);
     for (std::size_t k = 0; k < parts.size(); ++k) {
         std::shared_ptr<const StepDeformation> part = std::move(parts[k]);

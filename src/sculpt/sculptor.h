@@ -84,7 +84,11 @@ class Sculptor {
     // The stroke step: one deformation advected (band growth, sampling, renormalization),
     // then the touched leaves re-meshed.
     SegmentReport applySegment(const StepDeformation& deformation);
-    // Every segment of a stroke, planned on the grid as it is now; `each` sees every
+    // One dab of smoothing (levelset/smooth.h), recorded and re-meshed as a segment is; the
+    // report has no deformation.
+    SegmentReport applySmoothDab(const SmoothBrush& brush);
+    // Every segment of a stroke, planned on the grid as it is now (a smooth stroke's dabs
+    // each on the grid the one before left); `each` sees every
     // segment's report. Returns the last.
     SegmentReport applyStroke(const Stroke& stroke,
                               const std::function<void(const SegmentReport&)>& each = {});

@@ -119,6 +119,15 @@ std::vector<std::unique_ptr<StepDeformation>> planKeyedStroke(const Stroke& stro
     return parts;
 }
 
+SmoothBrush smoothDab(const SmoothStroke& stroke, std::size_t k) {
+    SmoothBrush b;
+    b.center = stroke.tool.path.at(k).t;
+    b.radius = stroke.tool.size.x();
+    b.falloff = stroke.tool.falloff;
+    b.time = stroke.strength * kSmoothTimePerRadius2 * b.radius * b.radius;
+    return b;
+}
+
 std::size_t segmentCount(const Stroke& stroke, double voxelSize) {
     if (const auto* sweep = std::get_if<SweepStroke>(&stroke))
         return toSweep(*sweep).segmentCount();
@@ -131,6 +140,7 @@ std::size_t segmentCount(const Stroke& stroke, double voxelSize) {
         return std::size_t(std::max(1, flow->segments));
     if (const auto* fluid = std::get_if<FluidStroke>(&stroke))
         return fluid->path.size() < 2 ? 0 : fluid->path.size() - 1;
+    if (const auto* smooth = std::get_if<SmoothStroke>(&stroke)) return smooth->tool.path.size();
     return 1;
 }
 
@@ -154,7 +164,8 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                     parts.push_back(std::make_unique<SwirlSegment>(toSwirl(s)));
             },
             [&](const InflateStroke& s) {
-                parts.push_back(std::make_unique<Inflation>(s.at, s.strength * s.radius, reach()));
+                parts.push_back(
+                    std::make_unique<Inflation>(s.at, s.strength * s.radius, reach(), s.remove));
             },
             [&](const PinchStroke& s) { parts = planPinch(s, grid.voxelSize()[0]); },
             [&](const StrangleStroke& s) { parts = planStrangle(s, grid.voxelSize()[0]); },
@@ -173,6 +184,7 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                     parts.push_back(
                         sweptFluidSegment(*s.fluid, s.radius, s.path[k], s.path[k + 1]));
             },
+            [&](const SmoothStroke&) {},
         },
         stroke);
     return parts;

@@ -13,6 +13,8 @@
 //   slide   - a sweep in a local frame keyed over time (3.6.1)
 //   flow    - the shape carried by a velocity field over a span of time (chapter 4)
 //   fluid   - a ball pushed through the shape as through a fluid (swept fluid, 4.2)
+//   smooth  - the surface under a ball relaxed by mean-curvature flow (levelset/smooth.h):
+//             not a deformation of space, so no exact shape stands behind it
 #pragma once
 
 #include <cstddef>
@@ -32,6 +34,7 @@
 #include "deform/sweep.h"
 #include "deform/swept_fluid.h"
 #include "deform/swirl.h"
+#include "levelset/smooth.h"
 #include "levelset/vdb.h"
 
 namespace sweepers {
@@ -103,10 +106,13 @@ struct SwirlStroke {
     double strength = 1.0;
 };
 
+// remove: the ball is sucked back into its centre instead (2.31, the inverse inflation):
+// clay taken away.
 struct InflateStroke {
     Eigen::Vector3d at = Eigen::Vector3d::Zero();
     double radius = 0.1;
     double strength = 1.0;
+    bool remove = false;
 };
 
 struct PinchStroke : PinchSpec {};
@@ -147,8 +153,18 @@ struct FluidStroke {
     std::shared_ptr<const SweptFluid> fluid;
 };
 
+// Smoothing under a ball: one dab at each placement of the tool's path (its translation; the
+// radius and falloff are the tool's), each a mean-curvature flow (levelset/smooth.h) lasting
+// strength x kSmoothTimePerRadius2 x radius^2. The velocity is the surface's own curvature,
+// so each dab runs on the grid the one before left: planStroke makes no deformation of it
+// (Sculptor::applyStroke runs the dabs), and a history holding one has no exact reference.
+struct SmoothStroke {
+    ToolSpec tool; // a ball
+    double strength = 1.0;
+};
+
 using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke, PinchStroke, StrangleStroke,
-                            KeyframedStroke, SlideStroke, FlowStroke, FluidStroke>;
+                            KeyframedStroke, SlideStroke, FlowStroke, FluidStroke, SmoothStroke>;
 
 struct StrokeScript {
     int version = 1;
@@ -159,6 +175,9 @@ struct StrokeScript {
     // stroke; 0 or missing where the script does not say.
     std::vector<double> durations;
 };
+
+// Dab k of a smooth stroke as a brush.
+SmoothBrush smoothDab(const SmoothStroke& stroke, std::size_t k);
 
 // The deformation a sweep stroke describes. Throws std::invalid_argument for a baked tool
 // that was not loaded.
@@ -176,13 +195,14 @@ std::vector<std::unique_ptr<StepDeformation>> planKeyedStroke(const Stroke& stro
 
 // How many deformations planStroke makes of a stroke at the given voxel size (a sweep's
 // segments, a pinch's or a strangle's segments and its pull, a flow's segments when it
-// gives them, else one).
+// gives them, a smooth stroke's dabs, else one).
 std::size_t segmentCount(const Stroke& stroke, double voxelSize);
 
 // The deformations of one stroke, in order: a sweep's segments, one swirl ring or
 // inflation (whose reach depends on the grid as it is when the stroke comes), or the
 // segments of a pinch or a strangle (whose sub-steps depend on the voxel size), those of
-// a keyed stroke at its last key, a flow's or a fluid tool's segments. Throws
+// a keyed stroke at its last key, a flow's or a fluid tool's segments; none for a smooth
+// stroke, which deforms nothing (Sculptor::applyStroke runs its dabs). Throws
 // std::invalid_argument for a fluid stroke whose solution was not found.
 std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke);
 

@@ -201,9 +201,14 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
         row.advectSeconds += r.advectSeconds();
         row.renormSeconds += r.stats.renormalizeSeconds;
     }
+    // A smooth dab is no deformation (its report has none): no exact shape stands behind a
+    // history that smooths, and its error columns stay NaN.
+    const bool exact =
+        std::all_of(history.begin(), history.end(), [](const auto& d) { return bool(d); });
     ExactReference reference(startShape);
-    for (auto& d : history)
-        reference.append(std::move(d));
+    if (exact)
+        for (auto& d : history)
+            reference.append(std::move(d));
     const auto t1 = Clock::now();
     SurfaceMesher mesher;
     mesher.rebuild(sculptor.grid(), interrupter);
@@ -221,7 +226,14 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
     row.euler = m.eulerCharacteristic;
     row.genus = m.genus;
     row.components = m.components;
-    row.error = interfaceError(*run.grid, run.mesh, reference, interrupter);
+    if (exact) {
+        row.error = interfaceError(*run.grid, run.mesh, reference, interrupter);
+    } else {
+        const double none = std::numeric_limits<double>::quiet_NaN();
+        row.error.mean = row.error.rms = row.error.max = none;
+        row.error.meshVolume = row.error.referenceVolume = none;
+        row.referenceTopologyKnown = false;
+    }
     return run;
 }
 

@@ -272,6 +272,22 @@ def test_radial_symmetry_makes_the_grid_symmetric():
         radial_grab(65)
 
 
+def test_smoothing_has_no_exact_shape_behind_it():
+    # A smooth dab relaxes the surface (a sphere shrinks a little, by mean-curvature flow),
+    # is recorded, undone like any stroke, and leaves no exact reference to measure against.
+    sculptor = sweepers.Sculptor(voxel_size=1 / 32)
+    before = sculptor.volume
+    sculptor.apply({"type": "smooth", "strength": 1.0,
+                    "tool": {"shape": "ball", "size": 0.4, "falloff": 0.2,
+                             "path": [{"t": [0, 1, 0]}, {"t": [0.1, 0.99, 0]}]}})
+    assert 0.99 * before < sculptor.volume < before
+    assert sculptor.script()["strokes"][0]["type"] == "smooth"
+    with pytest.raises(ValueError, match="no exact shape"):
+        sculptor.shape().exact_distance(np.zeros((1, 3)))
+    sculptor.undo()
+    assert sculptor.volume == before
+
+
 def test_exact_distance_is_the_moved_sphere():
     # rigid_motion.json carries a sphere of radius 0.5 rigidly, inside a tool that holds it
     # whole: its exact shape is the sphere at the path's last placement.

@@ -1,0 +1,187 @@
+#include "levelset/smooth.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include "core/falloff.h"
+#include "levelset/fast_marching.h"
+#include "levelset/parallel.h"
+
+namespace sweepers {
+
+namespace {
+
+using Leaf = Grid::TreeType::LeafNodeType;
+
+// A leaf's values and the layer of voxels around it (10 x 10 x 10, x slowest): the
+// stencils of a step read this block instead of the tree.
+struct PaddedLeaf {
+    std::array<float, 1000> v;
+    float at(int x, int y, int z) const {
+        return v[std::size_t((x + 1) * 100 + (y + 1) * 10 + z + 1)];
+    }
+    void load(const Leaf& leaf, const Grid::ConstAccessor& acc) {
+        const openvdb::Coord o = leaf.origin();
+        for (int x = -1; x <= 8; ++x)
+            for (int y = -1; y <= 8; ++y)
+                for (int z = -1; z <= 8; ++z) {
+                    const bool inside = x >= 0 && x < 8 && y >= 0 && y < 8 && z >= 0 && z < 8;
+                    v[std::size_t((x + 1) * 100 + (y + 1) * 10 + z + 1)] =
+                        inside ? leaf.getValue(Leaf::coordToOffset(o.offsetBy(x, y, z)))
+                               : acc.getValue(o.offsetBy(x, y, z));
+                }
+    }
+};
+
+// kappa |grad phi| by central differences at (x, y, z) of the block (the curvature term of
+// the level-set equation for mean-curvature flow), in world units:
+//   (phi_xx (phi_y^2 + phi_z^2) + ... - 2 (phi_x phi_y phi_xy + ...)) / |grad phi|^2.
+double curvatureTerm(const PaddedLeaf& b, int x, int y, int z, double h) {
+    const auto v = [&](int dx, int dy, int dz) { return double(b.at(x + dx, y + dy, z + dz)); };
+    const double p = v(0, 0, 0);
+    const double gx = 0.5 * (v(1, 0, 0) - v(-1, 0, 0)), gy = 0.5 * (v(0, 1, 0) - v(0, -1, 0)),
+                 gz = 0.5 * (v(0, 0, 1) - v(0, 0, -1));
+    const double xx = v(1, 0, 0) - 2 * p + v(-1, 0, 0), yy = v(0, 1, 0) - 2 * p + v(0, -1, 0),
+                 zz = v(0, 0, 1) - 2 * p + v(0, 0, -1);
+    const double xy = 0.25 * (v(1, 1, 0) - v(1, -1, 0) - v(-1, 1, 0) + v(-1, -1, 0));
+    const double xz = 0.25 * (v(1, 0, 1) - v(1, 0, -1) - v(-1, 0, 1) + v(-1, 0, -1));
+    const double yz = 0.25 * (v(0, 1, 1) - v(0, 1, -1) - v(0, -1, 1) + v(0, -1, -1));
+    const double g2 = gx * gx + gy * gy + gz * gz;
+    if (g2 < 1e-12 * h * h) return 0.0;
+    const double num = xx * (gy * gy + gz * gz) + yy * (gx * gx + gz * gz) +
+                       zz * (gx * gx + gy * gy) -
+                       2.0 * (gx * gy * xy + gx * gz * xz + gy * gz * yz);
+    return num / g2 / (h * h); // the differences are per voxel: h^2 kappa |grad phi|
+}
+
+} // namespace
+
+CurvatureSmoother::CurvatureSmoother(Grid& grid, const SmoothBrush& brush, Interrupter* interrupter)
+    : grid_(grid), brush_(brush), interrupter_(interrupter) {
+    const double h = grid.voxelSize()[0];
+    const openvdb::Vec3d c =
+        grid.worldToIndex({brush.center.x(), brush.center.y(), brush.center.z()});
+    // The brush's reach, the band around it (renormalization rebuilds the band there) and
+    // the voxel the central differences read beyond it.
+    const double margin = reachRadius() / h + 2.0;
+    reach_ = openvdb::CoordBBox(openvdb::Coord::floor(c - openvdb::Vec3d(margin)),
+                                openvdb::Coord::ceil(c + openvdb::Vec3d(margin)));
+}
+
+SmoothStats CurvatureSmoother::run() {
+    stats_ = SmoothStats();
+    stats_.changed = reach_;
+    if (!(brush_.time > 0.0) || !(brush_.radius > 0.0)) return stats_;
+    collectLeaves();
+    pollInterrupt(interrupter_);
+    flow();
+    pollInterrupt(interrupter_);
+    renormalizeReach();
+    return stats_;
+}
+
+void CurvatureSmoother::collectLeaves() {
+    leaves_.clear();
+    // Leaf by leaf origin inside the reach: the work is the brush's, not the grid's.
+    const openvdb::Coord lo = reach_.min() & ~(Leaf::DIM - 1), hi = reach_.max();
+    for (int x = lo.x(); x <= hi.x(); x += Leaf::DIM)
+        for (int y = lo.y(); y <= hi.y(); y += Leaf::DIM)
+            for (int z = lo.z(); z <= hi.z(); z += Leaf::DIM)
+                if (Leaf* leaf = grid_.tree().probeLeaf({x, y, z})) leaves_.push_back(leaf);
+    stats_.leaves = leaves_.size();
+}
+
+void CurvatureSmoother::flow() {
+    const double h = grid_.voxelSize()[0];
+    // Explicit steps of the central scheme are stable for dt <= h^2 / 4: along the surface
+    // (|grad phi| = 1) the flow is a diffusion in two dimensions, whose fastest mode (the
+    // checkerboard) decays at 8 / h^2. A little under it.
+    const double dtMax = 0.9 * h * h / 4.0;
+    const int steps = std::max(1, int(std::ceil(brush_.time / dtMax)));
+    const double dt = brush_.time / steps;
+    stats_.steps = steps;
+    // The whole band flows, so that the differences read consistent values; no value moves
+    // more than two voxels in a dab, so the surface stays inside the band that holds it.
+    const float most = float(2.0 * h);
+    const double r = brush_.radius, f = brush_.falloff;
+    // The weights, and the leaves with an active voxel the brush reaches: only those flow.
+    std::vector<std::array<float, Leaf::SIZE>> weight(leaves_.size());
+    std::vector<char> reached(leaves_.size(), 0);
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves_.size()), [&](const auto& range) {
+        for (std::size_t l = range.begin(); l != range.end(); ++l) {
+            const Leaf& leaf = *leaves_[l];
+            for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
+                weight[l][i] = 0.0f;
+                if (!leaf.isValueOn(i)) continue;
+                const openvdb::Vec3d w = grid_.indexToWorld(leaf.offsetToGlobalCoord(i));
+                const double d = (Eigen::Vector3d(w.x(), w.y(), w.z()) - brush_.center).norm() - r;
+                weight[l][i] = float(falloffMu(d, f));
+                reached[l] |= weight[l][i] > 0.0f;
+            }
+        }
+    });
+    std::vector<std::size_t> flowing;
+    for (std::size_t l = 0; l < leaves_.size(); ++l)
+        if (reached[l]) flowing.push_back(l);
+    std::vector<std::array<float, Leaf::SIZE>> next(flowing.size()), start(flowing.size());
+    for (std::size_t k = 0; k < flowing.size(); ++k) {
+        const float* values = leaves_[flowing[k]]->buffer().data();
+        std::copy(values, values + Leaf::SIZE, start[k].begin());
+    }
+    tbb::enumerable_thread_specific<std::size_t> updates(0);
+    for (int s = 0; s < steps; ++s) {
+        parallelFor(tbb::blocked_range<std::size_t>(0, flowing.size()), [&](const auto& range) {
+            const Grid::ConstAccessor acc = grid_.getConstAccessor();
+            PaddedLeaf block;
+            std::size_t n = 0;
+            for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                const std::size_t l = flowing[k];
+                const Leaf& leaf = *leaves_[l];
+                block.load(leaf, acc);
+                for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
+                    const int x = int(i >> 6), y = int((i >> 3) & 7), z = int(i & 7);
+                    const float p = block.at(x, y, z);
+                    next[k][i] = p;
+                    if (weight[l][i] == 0.0f) continue;
+                    const double moved = p + dt * weight[l][i] * curvatureTerm(block, x, y, z, h);
+                    next[k][i] = std::clamp(float(moved), start[k][i] - most, start[k][i] + most);
+                    ++n;
+                }
+            }
+            updates.local() += n;
+        });
+        parallelFor(tbb::blocked_range<std::size_t>(0, flowing.size()), [&](const auto& range) {
+            for (std::size_t k = range.begin(); k != range.end(); ++k)
+                std::copy(next[k].begin(), next[k].end(), leaves_[flowing[k]]->buffer().data());
+        });
+        pollInterrupt(interrupter_);
+    }
+    stats_.updates = updates.combine(std::plus<>());
+}
+
+void CurvatureSmoother::renormalizeReach() {
+    // The voxels within the reach less a voxel: beyond them every value stays as it was (the
+    // box's corners too) but for an inactive voxel next to them that the band takes in.
+    const openvdb::Vec3d c =
+        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+    const double h = grid_.voxelSize()[0], r = reachRadius() / h - 1.0;
+    VoxelList inside;
+    inside.reserve(leaves_.size());
+    for (const Leaf* leaf : leaves_) {
+        LeafVoxels lv{leaf->origin(), {}};
+        for (openvdb::Index i = 0; i < Leaf::SIZE; ++i)
+            if ((leaf->offsetToGlobalCoord(i).asVec3d() - c).lengthSqr() <= r * r)
+                lv.words[i >> 6] |= leafwords::Word(1) << (i & 63);
+        if (leafwords::any(lv.words)) inside.push_back(lv);
+    }
+    renormalize(grid_, reach_, inside, FmmOrder::Second, interrupter_);
+}
+
+SmoothStats smoothLevelSet(Grid& grid, const SmoothBrush& brush, Interrupter* interrupter) {
+    return CurvatureSmoother(grid, brush, interrupter).run();
+}
+
+} // namespace sweepers
