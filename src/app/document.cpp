@@ -77,9 +77,14 @@ Document Document::open(const std::string& path, double meshVoxelSize, const Pro
 }
 
 void Document::beginStroke(const ToolSpec& tool, MirrorAxis mirror) {
-    if (tool.path.size() != 1) throw std::invalid_argument("a stroke starts at one placement");
+    beginStroke(SweepStroke{mirror, {tool}});
+}
+
+void Document::beginStroke(const SweepStroke& start) {
+    if (start.tools.size() != 1 || start.tools[0].path.size() != 1)
+        throw std::invalid_argument("a stroke starts with one tool at one placement");
     beginEdit();
-    current_ = SweepStroke{mirror, {tool}};
+    current_ = start;
     inStroke_ = true;
 }
 

@@ -65,6 +65,9 @@ class Document {
     // Sculpting: a sweep of one tool whose path grows by one placement per drag event;
     // each new placement is advected at once as one segment. One undo step.
     void beginStroke(const ToolSpec& tool, MirrorAxis mirror);
+    // The same for a sweep of one tool whose path holds its first placement, with the
+    // stroke's mirror, strength and radial symmetry.
+    void beginStroke(const SweepStroke& start);
     bool inStroke() const { return inStroke_; }
     SegmentReport extendStroke(const Placement& next);
     void endStroke() { endEdit(); }

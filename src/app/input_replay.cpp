@@ -86,6 +86,8 @@ InputReplay readInputReplay(const std::string& path) {
                     throw std::runtime_error("unknown button \"" + b + "\"");
                 ev.x = number("x");
                 ev.y = number("y");
+                ev.ctrl = e.value("ctrl", false);   // ctrl + left: the tool inverted
+                ev.shift = e.value("shift", false); // shift + left: smooth
             } else if (type == "move") {
                 ev.type = InputEvent::Type::Move;
                 ev.x = number("x");

@@ -3,6 +3,7 @@
 //
 //   { "events": [
 //       { "frame": 3, "type": "press",   "button": "left", "x": 400, "y": 300 },
+//                                          (and "shift": true to smooth, "ctrl": true to invert)
 //       { "frame": 4, "type": "move",    "x": 420, "y": 290 },
 //       { "frame": 5, "type": "release", "button": "left", "x": 420, "y": 290 },
 //       { "frame": 7, "type": "key",     "key": "z", "ctrl": true, "shift": false },

@@ -209,8 +209,8 @@ class Modeler {
     }
 
     // --- input from GLFW's callbacks (ImGui keeps what falls on its panels) -------------
-    void onButton(int button, bool press, double x, double y, bool shift) {
-        if (!job_) ctl_.onButton(button, press, x, y, shift);
+    void onButton(int button, bool press, double x, double y, bool shift, bool ctrl) {
+        if (!job_) ctl_.onButton(button, press, x, y, shift, ctrl);
     }
     void onMove(double x, double y) {
         if (!job_) ctl_.onMove(x, y);
@@ -624,6 +624,8 @@ class Modeler {
         if (const auto centre = ctl_.toolCentre()) {
             tool.visible = true;
             tool.center = *centre;
+            for (const glm::dvec3& p : ctl_.symmetryPreview(*centre))
+                tool.lines.emplace_back(p);
         }
         if (const auto stroke = ctl_.topologyStroke())
             for (const glm::dvec3& p : strokePreview(*stroke))
@@ -749,10 +751,24 @@ class Modeler {
                                ImGuiSliderFlags_Logarithmic))
             s.falloff = f;
         mustFit("falloff  shift [ ]");
+        float strength = float(s.strength);
+        if (ImGui::SliderFloat("strength  shift F", &strength, 0.01f, 1.0f, "%.2f"))
+            s.strength = std::clamp(double(strength), 0.01, 1.0);
+        mustFit("strength  shift F");
         int mirror = int(s.mirror);
         ImGui::Combo("mirror (M)", &mirror, "none\0x\0y\0z\0");
         mustFit("mirror (M)");
         s.mirror = MirrorAxis(mirror);
+        ImGui::SliderInt("radial", &s.radialCount, 1, 64);
+        mustFit("radial");
+        if (s.radialCount > 1) {
+            ImGui::Combo("radial axis", &s.radialAxis, "x\0y\0z\0");
+            mustFit("radial axis");
+        }
+        if (ctl_.sizing() != Sizing::None)
+            ImGui::TextWrapped("Move the mouse to set the %s; click to keep it, Esc to put it "
+                               "back.",
+                               ctl_.sizing() == Sizing::Radius ? "radius" : "strength");
         ImGui::Checkbox("wireframe (W)", &s.wireframe);
         // The surface's look: clay, or a matcap that reads form without lights.
         int look = int(renderer_->look());
@@ -1002,7 +1018,8 @@ void buttonCallback(GLFWwindow* w, int button, int action, int mods) {
     double x, y;
     glfwGetCursorPos(w, &x, &y);
     const int b = button == GLFW_MOUSE_BUTTON_LEFT ? 0 : button == GLFW_MOUSE_BUTTON_RIGHT ? 1 : 2;
-    m->onButton(b, action == GLFW_PRESS, x, y, (mods & GLFW_MOD_SHIFT) != 0);
+    m->onButton(b, action == GLFW_PRESS, x, y, (mods & GLFW_MOD_SHIFT) != 0,
+                (mods & GLFW_MOD_CONTROL) != 0);
 }
 void cursorCallback(GLFWwindow* w, double x, double y) {
     wakeCallback(w);

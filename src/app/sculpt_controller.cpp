@@ -44,10 +44,15 @@ void SculptController::setViewport(int width, int height) {
     height_ = std::max(height, 1);
 }
 
-void SculptController::onButton(int button, bool press, double x, double y, bool shift) {
+void SculptController::onButton(int button, bool press, double x, double y, bool shift, bool ctrl) {
     if (!doc_) return;
     cursorX_ = x;
     cursorY_ = y;
+    if (sizing_ != Sizing::None) {
+        // The click that ends F or Shift-F keeps what the mouse set; it sculpts nothing.
+        if (press && button == 0) sizing_ = Sizing::None;
+        return;
+    }
     if (!press) {
         if (drag_ == DragKind::Sculpt) {
             // The last position counts; the drag ends once its work is done.
@@ -62,10 +67,12 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
     if (busy() || drag_ == DragKind::Sculpt) return;
     pressX_ = lastX_ = x;
     pressY_ = lastY_ = y;
-    if (button == 1 || button == 2 || (button == 0 && shift)) {
+    if (button == 1 || button == 2) {
         drag_ = DragKind::Pan;
         return;
     }
+    mode_ = shift ? SculptMode::Smooth : settings_.mode;
+    inverted_ = ctrl;
     const auto hit = sculpting_ ? pick(x, y) : std::nullopt;
     if (!hit) {
         drag_ = DragKind::Orbit;
@@ -81,12 +88,11 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
         beginTopologyDrag();
         return;
     }
-    if (settings_.mode == SculptMode::Swirl || settings_.mode == SculptMode::Fluid ||
-        settings_.mode == SculptMode::Clay) {
+    if (mode_ == SculptMode::Swirl || mode_ == SculptMode::Fluid || dabMode()) {
         doc_->beginEdit();
-        if (settings_.mode == SculptMode::Clay) {
+        if (dabMode()) {
             pendingSince_ = Clock::now();
-            dab(grab_);
+            mode_ == SculptMode::Clay ? dab(grab_) : smoothDab(grab_);
         }
         return;
     }
@@ -95,7 +101,7 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
     tool.size = Eigen::Vector3d::Constant(settings_.radius);
     tool.falloff = settings_.falloff;
     tool.path = {last_};
-    if (settings_.bakedTool && settings_.mode != SculptMode::Inflate) {
+    if (settings_.bakedTool && mode_ != SculptMode::Inflate) {
         // The baked tool at the size the radius asks (its own half-size is 1), with a band
         // for this falloff (loaded again only when the falloff outgrows the last band).
         tool.shape = ToolShapeKind::Baked;
@@ -110,7 +116,27 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
             return;
         }
     }
-    doc_->beginStroke(tool, settings_.mirror);
+    SweepStroke stroke;
+    stroke.mirror = settings_.mirror;
+    stroke.tools = {tool};
+    stroke.strength = settings_.strength;
+    stroke.radial = radial();
+    doc_->beginStroke(stroke);
+}
+
+RadialSymmetry SculptController::radial() const {
+    RadialSymmetry r;
+    r.axis = Eigen::Vector3d::Unit(std::clamp(settings_.radialAxis, 0, 2));
+    r.count = std::clamp(settings_.radialCount, 1, 64);
+    return r;
+}
+
+std::vector<Eigen::Affine3d> SculptController::radialTurns() const {
+    const RadialSymmetry r = radial();
+    std::vector<Eigen::Affine3d> turns;
+    for (int k = 0; k < r.count; ++k)
+        turns.emplace_back(Eigen::AngleAxisd(2.0 * M_PI * k / r.count, r.axis));
+    return turns;
 }
 
 void SculptController::useToolFile(const std::string& path) {
@@ -152,7 +178,7 @@ std::optional<Stroke> SculptController::topologyStroke() const {
     const glm::dvec3 w =
         camera_.dragInViewPlane(grab_, pressX_, pressY_, cursorX_, cursorY_, width_, height_);
     const double h = doc_->grid().voxelSize()[0], f = settings_.falloff;
-    if (settings_.mode == SculptMode::Pinch) {
+    if (mode_ == SculptMode::Pinch) {
         // The tips start half a falloff outside both sides; the drag opens the hole. The
         // needles' funnels are as thin as their falloff allows: below about 13 voxels the
         // grid loses them on axes off its own (measured on a unit sphere at 1/32: a plug
@@ -202,9 +228,44 @@ void SculptController::stepTopologyDrag() {
 // Clay mode: one inflation of the tool's radius (2.30) centred half a radius under the
 // surface point p (along the view ray), so that it adds the whole ball (a centre inside
 // the material gives the inserted ball its sign).
+// With Ctrl, a ball sucked back into its centre (2.31), which takes away the material
+// inside it: a whole radius under the surface, so that all of it is material and a dab
+// takes away what one adds. A dab's radial copies are dabs turned about the axis.
 void SculptController::dab(const glm::dvec3& p) {
-    const glm::dvec3 in = p + 0.5 * settings_.radius * glm::normalize(p - camera_.eye());
-    const InflateStroke stroke{toEigen3(in), settings_.radius};
+    const double depth = (inverted_ ? 1.0 : 0.5) * settings_.radius;
+    const glm::dvec3 in = p + depth * glm::normalize(p - camera_.eye());
+    std::vector<InflateStroke> strokes;
+    for (const Eigen::Affine3d& turn : radialTurns()) {
+        InflateStroke stroke{turn * toEigen3(in), settings_.radius};
+        stroke.strength = settings_.strength;
+        stroke.remove = inverted_;
+        strokes.push_back(stroke);
+    }
+    Document* doc = doc_;
+    launch([doc, strokes] {
+        SegmentReport r;
+        for (const InflateStroke& s : strokes)
+            r = doc->applyStroke(s);
+        return r;
+    });
+    lastDab_ = p;
+    dabX_ = cursorX_;
+    dabY_ = cursorY_;
+}
+
+// One dab of smoothing centred on the surface point p, and its radial copies. (Smoothing
+// has no inverse worth having: sharpening is the heat equation run backward, which blows
+// up the finest noise first. Ctrl changes nothing.)
+void SculptController::smoothDab(const glm::dvec3& p) {
+    SmoothStroke stroke;
+    stroke.tool.size = Eigen::Vector3d::Constant(settings_.radius);
+    stroke.tool.falloff = settings_.falloff;
+    stroke.strength = settings_.strength;
+    for (const Eigen::Affine3d& turn : radialTurns()) {
+        Placement at;
+        at.t = turn * toEigen3(p);
+        stroke.tool.path.push_back(at);
+    }
     Document* doc = doc_;
     launch([doc, stroke] { return doc->applyStroke(stroke); });
     lastDab_ = p;
@@ -216,6 +277,12 @@ void SculptController::onMove(double x, double y) {
     const double dx = x - lastX_, dy = y - lastY_;
     cursorX_ = x;
     cursorY_ = y;
+    if (sizing_ != Sizing::None) {
+        moveSizing(x, y);
+        lastX_ = x;
+        lastY_ = y;
+        return;
+    }
     switch (drag_) {
     case DragKind::Orbit:
         camera_.orbit(-dx * 0.008, dy * 0.008);
@@ -246,6 +313,11 @@ void SculptController::onScroll(double dy, bool ctrl) {
 KeyAction SculptController::onKey(int key, bool ctrl, bool shift) {
     if (!doc_) return KeyAction::None;
     if (key == GLFW_KEY_ESCAPE) {
+        if (sizing_ != Sizing::None) {
+            (sizing_ == Sizing::Radius ? settings_.radius : settings_.strength) = sizingFrom_;
+            sizing_ = Sizing::None;
+            return KeyAction::None;
+        }
         if (busy()) cancel();
         return KeyAction::Cancel;
     }
@@ -265,6 +337,9 @@ KeyAction SculptController::onKey(int key, bool ctrl, bool shift) {
     double& size = shift ? settings_.falloff : settings_.radius; // [ and ]: shift for falloff
     switch (key) {
     case 'F':
+        if (drag_ == DragKind::None) beginSizing(shift ? Sizing::Strength : Sizing::Radius);
+        break;
+    case GLFW_KEY_HOME:
         if (!busy()) frameView();
         break;
     case 'W':
@@ -308,7 +383,7 @@ void SculptController::dispatch(const InputEvent& e) {
     case InputEvent::Type::Press:
     case InputEvent::Type::Release:
         onMove(e.x, e.y);
-        onButton(e.button, e.type == InputEvent::Type::Press, e.x, e.y, e.shift);
+        onButton(e.button, e.type == InputEvent::Type::Press, e.x, e.y, e.shift, e.ctrl);
         break;
     case InputEvent::Type::Move:
         onMove(e.x, e.y);
@@ -333,9 +408,33 @@ std::optional<glm::dvec3> SculptController::pick(double x, double y) const {
     return toGlm(*hit);
 }
 
+// F: the circle is drawn about the surface point under the cursor when F was pressed (or
+// the view's centre off the shape), and the mouse's distance from that point on the screen,
+// taken into the view plane there, is the radius. Shift-F: that distance over a fifth of
+// the window's height is the strength.
+void SculptController::beginSizing(Sizing what) {
+    sizing_ = what;
+    sizingX_ = cursorX_;
+    sizingY_ = cursorY_;
+    sizingAt_ = pick(cursorX_, cursorY_).value_or(camera_.target);
+    sizingFrom_ = what == Sizing::Radius ? settings_.radius : settings_.strength;
+}
+
+void SculptController::moveSizing(double x, double y) {
+    if (sizing_ == Sizing::Radius) {
+        const glm::dvec3 w =
+            camera_.dragInViewPlane(sizingAt_, sizingX_, sizingY_, x, y, width_, height_);
+        settings_.radius = std::clamp(glm::length(w), 0.02, 2.0);
+    } else {
+        const double pixels = std::hypot(x - sizingX_, y - sizingY_);
+        settings_.strength = std::clamp(pixels / (0.2 * height_), 0.01, 1.0);
+    }
+}
+
 std::optional<glm::dvec3> SculptController::toolCentre() const {
+    if (sizing_ != Sizing::None) return sizingAt_;
     if (drag_ == DragKind::Sculpt) {
-        if (settings_.mode == SculptMode::Clay || topologyMode()) return std::nullopt;
+        if (dabMode() || topologyMode()) return std::nullopt;
         return toGlm(last_.t);
     }
     if (drag_ == DragKind::None && !busy() && sculpting_) return pick(cursorX_, cursorY_);
@@ -349,34 +448,39 @@ void SculptController::frameView() {
     volume_ = doc_->mesher().enclosedVolume();
 }
 
-// The tool placement for the cursor at (x, y) during a drag, by mode.
+// The tool placement for the cursor at (x, y) during a drag, by mode; with Ctrl, the
+// hand's motion reversed (grab, swirl and fluid pull the other way, twist turns back,
+// inflate deflates).
 Placement SculptController::placementAt(double x, double y) const {
     Placement p;
     p.t = toEigen3(grab_);
-    switch (settings_.mode) {
+    const double sign = inverted_ ? -1.0 : 1.0;
+    switch (mode_) {
     case SculptMode::Grab:
     case SculptMode::Swirl:
     case SculptMode::Fluid:
     case SculptMode::Clay:
     case SculptMode::Pinch:
     case SculptMode::Strangle:
+    case SculptMode::Smooth:
         p.t = toEigen3(grab_ +
-                       camera_.dragInViewPlane(grab_, pressX_, pressY_, x, y, width_, height_));
+                       (topologyMode() ? 1.0 : sign) *
+                           camera_.dragInViewPlane(grab_, pressX_, pressY_, x, y, width_, height_));
         break;
     case SculptMode::Twist:
         p.axis = toEigen3(axis_);
-        p.angleDegrees = std::clamp(0.5 * (x - pressX_), -720.0, 720.0);
+        p.angleDegrees = sign * std::clamp(0.5 * (x - pressX_), -720.0, 720.0);
         break;
     case SculptMode::Inflate:
-        p.scale =
-            Eigen::Vector3d::Constant(std::exp(std::clamp(-(y - pressY_), -400.0, 400.0) * 0.004));
+        p.scale = Eigen::Vector3d::Constant(
+            std::exp(sign * std::clamp(-(y - pressY_), -400.0, 400.0) * 0.004));
         break;
     }
     return p;
 }
 
 std::vector<Placement> SculptController::placementsTo(const Placement& target) const {
-    if (settings_.mode != SculptMode::Twist) return {target};
+    if (mode_ != SculptMode::Twist) return {target};
     // The cursor gives an absolute angle; the hand's way from the last one is the
     // difference, however large, cut into equal turns no larger than the limit.
     const double turn = target.angleDegrees - last_.angleDegrees;
@@ -442,26 +546,29 @@ void SculptController::step() {
     if (pending_) {
         pending_ = false;
         Document* doc = doc_;
-        if (settings_.mode == SculptMode::Clay) {
-            // A new dab once the cursor has moved half a radius (in the view plane: the
-            // surface under a still cursor rises with every dab).
+        if (dabMode()) {
+            // A new dab of clay once the cursor has moved half a radius, of smoothing a
+            // quarter (in the view plane: the surface under a still cursor rises with every
+            // dab of clay).
             const double moved = glm::length(camera_.dragInViewPlane(
                 lastDab_, dabX_, dabY_, cursorX_, cursorY_, width_, height_));
-            if (moved >= 0.5 * settings_.radius) {
+            const double spacing = mode_ == SculptMode::Clay ? 0.5 : 0.25;
+            if (moved >= spacing * settings_.radius) {
                 if (const auto hit = pick(cursorX_, cursorY_)) {
-                    dab(*hit);
+                    mode_ == SculptMode::Clay ? dab(*hit) : smoothDab(*hit);
                     return;
                 }
             }
         } else if (const Placement p = placementAt(cursorX_, cursorY_); !(p == last_)) {
-            if (settings_.mode == SculptMode::Swirl) {
+            if (mode_ == SculptMode::Swirl) {
                 // A swirl ring carries the clay from the last position to this one.
                 SwirlStroke sw;
                 sw.at = last_.t;
                 sw.move = p.t - last_.t;
                 sw.radius = settings_.radius;
+                sw.strength = settings_.strength;
                 launch([doc, sw] { return doc->applyStroke(sw); });
-            } else if (settings_.mode == SculptMode::Fluid) {
+            } else if (mode_ == SculptMode::Fluid) {
                 // The ball pushes the clay as through a fluid from the last position to this
                 // one. The first fluid piece of a run finds the solution (from the cache, or
                 // a solve of a few seconds) on the worker, not in the window's thread.
@@ -504,6 +611,25 @@ void addCircle(std::vector<glm::dvec3>& lines, const glm::dvec3& c, const glm::d
 }
 
 } // namespace
+
+std::vector<glm::dvec3> SculptController::symmetryPreview(const glm::dvec3& centre) const {
+    std::vector<glm::dvec3> lines;
+    const glm::dvec3 facing = glm::normalize(camera_.eye() - camera_.target);
+    std::vector<glm::dvec3> copies;
+    for (const Eigen::Affine3d& turn : radialTurns())
+        copies.push_back(toGlm(turn * toEigen3(centre)));
+    if (settings_.mirror != MirrorAxis::None) {
+        const int axis = int(settings_.mirror) - 1;
+        for (std::size_t k = 0, n = copies.size(); k < n; ++k) {
+            glm::dvec3 m = copies[k];
+            m[axis] = -m[axis];
+            copies.push_back(m);
+        }
+    }
+    for (std::size_t k = 1; k < copies.size(); ++k)
+        addCircle(lines, copies[k], facing, settings_.radius);
+    return lines;
+}
 
 std::vector<glm::dvec3> strokePreview(const Stroke& stroke) {
     std::vector<glm::dvec3> lines;

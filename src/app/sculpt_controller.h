@@ -1,9 +1,9 @@
 // The modeler's input logic without a window: mouse, key and wheel events in (window
 // pixels, origin top left), camera moves and sculpting out. A drag on the shape becomes
 // tool placements, and each piece of sculpting (a sweep segment, a swirl ring, a dab of
-// clay) runs on a worker thread while the window keeps drawing; moves that arrive
-// meanwhile coalesce into the next piece. The modeler feeds it GLFW's events; tests feed it
-// replay files and read the recorded script, with no window at all.
+// clay, a dab of smoothing) runs on a worker thread while the window keeps drawing; moves
+// that arrive meanwhile coalesce into the next piece. The modeler feeds it GLFW's events; tests
+// feed it replay files and read the recorded script, with no window at all.
 #pragma once
 
 #include <array>
@@ -29,8 +29,9 @@ namespace sweepers {
 // keeping its volume (one swirl ring per piece, 4.1), and so does fluid (the swept fluid of
 // 4.2, one fluid stroke per piece); clay adds material (Decaudin's
 // inflation, 2.30) under the cursor. Pinch and strangle change the topology (3.5): a drag
-// sets them up, shown as a preview, and the release applies the whole stroke.
-enum class SculptMode { Grab, Twist, Inflate, Swirl, Fluid, Clay, Pinch, Strangle };
+// sets them up, shown as a preview, and the release applies the whole stroke. Smooth
+// relaxes the surface under the brush (levelset/smooth.h), one dab every quarter radius.
+enum class SculptMode { Grab, Twist, Inflate, Swirl, Fluid, Clay, Pinch, Strangle, Smooth };
 
 // Each mode's key and its name in the panel, in SculptMode's order: the key handler and the
 // panel both read this table.
@@ -39,7 +40,7 @@ struct ModeInfo {
     int key;
     const char* label;
 };
-inline constexpr std::array<ModeInfo, 8> kModes{{
+inline constexpr std::array<ModeInfo, 9> kModes{{
     {SculptMode::Grab, 'G', "Grab (G)"},
     {SculptMode::Twist, 'T', "Twist (T)"},
     {SculptMode::Inflate, 'I', "Inflate (I)"},
@@ -48,6 +49,7 @@ inline constexpr std::array<ModeInfo, 8> kModes{{
     {SculptMode::Clay, 'C', "Add clay (C)"},
     {SculptMode::Pinch, 'P', "Pinch a hole (P)"},
     {SculptMode::Strangle, 'K', "Strangle (K)"},
+    {SculptMode::Smooth, 'O', "Smooth (O, Shift-drag)"},
 }};
 enum class DragKind { None, Sculpt, Orbit, Pan };
 
@@ -55,6 +57,13 @@ struct ToolSettings {
     SculptMode mode = SculptMode::Grab;
     MirrorAxis mirror = MirrorAxis::None;
     double radius = 0.25, falloff = 0.25;
+    // (0, 1]: the fraction of the hand's motion a grab, twist or inflate applies, of a
+    // swirl's move, of the clay ball's radius, of a smooth dab's flow time.
+    double strength = 1.0;
+    // Radial symmetry: `radialCount` copies of a grab, twist or inflate tool (and of each
+    // dab of clay or smoothing) turned about the axis `radialAxis` (0 x, 1 y, 2 z) through
+    // the origin; 1 is the tool alone.
+    int radialCount = 1, radialAxis = 1;
     bool wireframe = false;
     // Grab and twist move this shape instead of a ball when set (a baked tool, 3.4.3),
     // scaled by `radius` over its own half-size `bakedRadius`.
@@ -62,6 +71,10 @@ struct ToolSettings {
     BakedToolSource bakedSource;
     double bakedRadius = 1.0;
 };
+
+// F and Shift-F: the radius, or the strength, set by moving the mouse (a circle on the
+// screen), a click to keep it, Esc to put it back.
+enum class Sizing { None, Radius, Strength };
 
 // What a key asks of the window beyond the controller's own state.
 enum class KeyAction { None, Save, Cancel };
@@ -88,8 +101,10 @@ class SculptController {
     void setViewport(int width, int height);
 
     // --- events -----------------------------------------------------------------------
-    // button: 0 left, 1 right, 2 middle.
-    void onButton(int button, bool press, double x, double y, bool shift);
+    // button: 0 left, 1 right, 2 middle. Shift with the left button smooths whatever the
+    // tool; Ctrl inverts the tool (inflate deflates, twist turns back, grab and swirl pull
+    // the other way, clay takes away).
+    void onButton(int button, bool press, double x, double y, bool shift, bool ctrl = false);
     void onMove(double x, double y);
     void onScroll(double dy, bool ctrl);
     KeyAction onKey(int key, bool ctrl, bool shift);
@@ -119,10 +134,15 @@ class SculptController {
     ToolSettings& settings() { return settings_; }
     const ToolSettings& settings() const { return settings_; }
     DragKind drag() const { return drag_; }
+    // F or Shift-F in progress: what the mouse sets, and where its circle is drawn.
+    Sizing sizing() const { return sizing_; }
     // Where the tool is drawn: during a drag its current placement, else under the cursor.
     std::optional<glm::dvec3> toolCentre() const;
     // The surface point under a window pixel.
     std::optional<glm::dvec3> pick(double x, double y) const;
+    // Line segments (pairs of ends) that show the symmetry around the tool at `centre`: a
+    // circle of the tool's radius, facing the view, at each radial and mirror copy.
+    std::vector<glm::dvec3> symmetryPreview(const glm::dvec3& centre) const;
     // During a pinch or strangle drag: the stroke the release will apply, as it stands.
     std::optional<Stroke> topologyStroke() const;
     // Grab and twist with the shape of a .vdb level set or a closed mesh (a mesh is sampled
@@ -153,10 +173,17 @@ class SculptController {
     void launch(std::function<SegmentReport()> task);
     void collect();
     void dab(const glm::dvec3& p);
+    void smoothDab(const glm::dvec3& p);
+    // The radial copies of a world transform (the identity first), as the panel sets them.
+    std::vector<Eigen::Affine3d> radialTurns() const;
+    RadialSymmetry radial() const;
+    void beginSizing(Sizing what);
+    void moveSizing(double x, double y);
     void finishDrag();
     bool topologyMode() const {
-        return settings_.mode == SculptMode::Pinch || settings_.mode == SculptMode::Strangle;
+        return mode_ == SculptMode::Pinch || mode_ == SculptMode::Strangle;
     }
+    bool dabMode() const { return mode_ == SculptMode::Clay || mode_ == SculptMode::Smooth; }
     void beginTopologyDrag();
     void stepTopologyDrag();
 
@@ -167,6 +194,11 @@ class SculptController {
     OrbitCamera camera_;
     ToolSettings settings_;
     DragKind drag_ = DragKind::None;
+    SculptMode mode_ = SculptMode::Grab; // of the drag in progress
+    bool inverted_ = false;              // Ctrl held at its press
+    Sizing sizing_ = Sizing::None;
+    double sizingX_ = 0, sizingY_ = 0, sizingFrom_ = 0;
+    glm::dvec3 sizingAt_{0.0};
     bool pending_ = false, releasing_ = false;
     double pressX_ = 0, pressY_ = 0, lastX_ = 0, lastY_ = 0, cursorX_ = -1, cursorY_ = -1;
     glm::dvec3 grab_{0.0}, axis_{0, 0, 1}, lastDab_{0.0};

@@ -162,6 +162,30 @@ assert info["euler_characteristic"] == 0 and info["components"] == 1, info
 print(f"pinch: a torus (genus {info['genus']}), hole radius {script['strokes'][0]['open']:.3f}")
 PY
 
+# --- what artists' hands bring: Shift-drag smooths, Ctrl-drag inverts inflate, Ctrl-click
+# takes away the clay a click added, F sizes the brush in the view and Shift-F its strength
+run --replay-input "$here/artist_habits.json" --save "$tmp/habits.vdb" \
+    --save-script "$tmp/habits.json" --screenshot "$tmp/habits.png"
+"$py" - "$tmp/habits.json" <<'PY'
+import json, sys
+strokes = json.load(open(sys.argv[1]))["strokes"]
+kinds = [s["type"] for s in strokes]
+smooth = [s for s in strokes if s["type"] == "smooth"]
+sweeps = [s for s in strokes if s["type"] == "sweep"]
+clay = [s for s in strokes if s["type"] == "inflate"]
+assert len(smooth) >= 3 and len(sweeps) == 2 and len(clay) == 2, kinds
+deflate = sweeps[0]["tools"][0]["path"][-1]["s"]
+assert all(v < 1 for v in (deflate if isinstance(deflate, list) else [deflate])), deflate
+assert "remove" not in clay[0] and clay[1]["remove"] is True, clay
+grab = sweeps[1]
+assert abs(grab["strength"] - 0.5) < 1e-9, grab
+assert grab["tools"][0]["size"] > 0.4, grab["tools"][0]["size"]  # F: 80 pixels, not 0.25
+print(f"habits: {len(smooth)} smooth dabs, a deflation (scale {deflate}), clay added and "
+      f"taken away, a grab of radius {grab['tools'][0]['size']:.3f} at strength 0.5")
+PY
+"$cli" apply "$tmp/habits.json" -o "$tmp/habits_replayed.vdb" -q
+"$py" "$here/same_grid.py" "$tmp/habits.vdb" "$tmp/habits_replayed.vdb"
+
 # --- two strokes, undo both, redo one: the grid after the first stroke, exactly --------
 run --replay-input "$here/drag_ab_undo.json" --save "$tmp/undo.vdb" --save-script "$tmp/undo.json"
 "$py" "$here/same_grid.py" "$tmp/a.vdb" "$tmp/undo.vdb"
@@ -174,7 +198,8 @@ run --replay-input "$here/drag_ab_undo.json" --save "$tmp/undo.vdb" --save-scrip
 cp "$tmp/a.json" "$tmp/windowed_drag_a.json"
 cp "$tmp/undo.json" "$tmp/windowed_drag_ab_undo.json"
 cp "$tmp/swirl.json" "$tmp/windowed_swirl_and_clay.json"
-for events in drag_a drag_ab_undo swirl_and_clay; do
+cp "$tmp/habits.json" "$tmp/windowed_artist_habits.json"
+for events in drag_a drag_ab_undo swirl_and_clay artist_habits; do
   "$headless" "$here/$events.json" 640 480 0.03125 "$tmp/headless_$events.json"
   cmp "$tmp/windowed_$events.json" "$tmp/headless_$events.json" ||
     fail "$events: the controller without a window recorded another script"

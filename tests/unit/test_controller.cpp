@@ -7,6 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#define GLFW_INCLUDE_NONE // key codes only
+#include <GLFW/glfw3.h>
+#include <openvdb/tools/Interpolation.h>
+
 #include "app/sculpt_controller.h"
 #include "grids.h"
 #include "io/stroke_script.h"
@@ -15,6 +19,7 @@
 #include "levelset/create.h"
 #include "levelset/fast_marching.h"
 #include "levelset/measure.h"
+#include "levelset/raycast.h"
 #include "replay.h"
 #include "scratch_dir.h"
 
@@ -427,4 +432,194 @@ TEST(SculptController, FluidModePushesTheClayAsAFluidAndKeepsItsVolume) {
     EXPECT_GT(activeWorldBox(b.doc.grid()).max.x(), 1.1); // pulled out to the right
     const StrokeScript recorded = parseStrokeScript(formatStrokeScript(b.doc.script()), "fluid");
     EXPECT_EQ(differingVoxels(*applyScript(recorded, "."), b.doc.grid()), 0u);
+}
+
+namespace {
+
+Eigen::Vector3d toEigen3(const glm::dvec3& v) {
+    return {v.x, v.y, v.z};
+}
+
+// A left drag from (x0, y0) to (x1, y1) in `moves` moves, one frame each, with the keys held.
+void dragOn(SculptController& ctl, double x0, double y0, double x1, double y1, int moves,
+            bool shift = false, bool ctrl = false) {
+    ctl.onMove(x0, y0);
+    ctl.onButton(0, true, x0, y0, shift, ctrl);
+    ASSERT_EQ(ctl.drag(), DragKind::Sculpt) << "the press missed the shape";
+    for (int k = 1; k <= moves; ++k) {
+        ctl.onMove(x0 + (x1 - x0) * k / moves, y0 + (y1 - y0) * k / moves);
+        ctl.step();
+    }
+    ctl.onButton(0, false, x1, y1, shift, ctrl);
+    ctl.wait();
+    ctl.step();
+    ASSERT_EQ(ctl.drag(), DragKind::None);
+    ASSERT_EQ(ctl.takeMessage(), "");
+}
+
+} // namespace
+
+TEST(SculptController, CtrlInvertsTheTool) {
+    const double x = kWidth / 2.0, y = kHeight / 2.0;
+    // Inflate: a drag up blows the clay up; with Ctrl the same drag lets it down.
+    for (const bool ctrl : {false, true}) {
+        Bench s;
+        const double volume = s.ctl.volume();
+        s.ctl.onKey('I', false, false);
+        dragOn(s.ctl, x, y, x, y - 60, 6, false, ctrl);
+        std::printf("[ invert ] inflate%s: volume %.4f -> %.4f\n", ctrl ? " with Ctrl" : "", volume,
+                    s.ctl.volume());
+        if (ctrl)
+            EXPECT_LT(s.ctl.volume(), volume - 0.002);
+        else
+            EXPECT_GT(s.ctl.volume(), volume + 0.002);
+    }
+    // Twist: Ctrl turns the other way.
+    {
+        Bench s;
+        s.ctl.onKey('T', false, false);
+        dragOn(s.ctl, x, y, x + 100, y, 5, false, true);
+        EXPECT_DOUBLE_EQ(s.tool().path.back().angleDegrees, -50.0);
+    }
+    // Clay: a dab adds a ball; Ctrl at the same pixel takes a ball away (from the surface
+    // the first one raised).
+    {
+        Bench s;
+        const double volume = s.ctl.volume();
+        s.ctl.onKey('C', false, false);
+        dragOn(s.ctl, x + 40, y + 30, x + 40, y + 30, 0);
+        const double added = s.ctl.volume();
+        dragOn(s.ctl, x + 40, y + 30, x + 40, y + 30, 0, false, true);
+        std::printf("[ invert ] clay: volume %.5f, %.5f with a dab, %.5f after Ctrl\n", volume,
+                    added, s.ctl.volume());
+        EXPECT_GT(added, volume + 0.02);
+        EXPECT_NEAR(s.ctl.volume(), volume, 0.005 * volume);
+        const auto& strokes = s.doc.script().strokes;
+        ASSERT_EQ(strokes.size(), 2u);
+        EXPECT_FALSE(std::get<InflateStroke>(strokes[0]).remove);
+        EXPECT_TRUE(std::get<InflateStroke>(strokes[1]).remove);
+    }
+}
+
+TEST(SculptController, ShiftDragSmoothsWhateverTheTool) {
+    Bench s;
+    s.ctl.onKey('G', false, false);
+    const GridPtr before = s.doc.grid().deepCopy();
+    const double volume = s.ctl.volume();
+    dragOn(s.ctl, kWidth / 2.0, kHeight / 2.0, kWidth / 2.0 + 60, kHeight / 2.0, 6, true);
+    const auto& strokes = s.doc.script().strokes;
+    ASSERT_GE(strokes.size(), 2u); // a dab at the press and one every quarter radius
+    for (const Stroke& st : strokes)
+        ASSERT_TRUE(std::holds_alternative<SmoothStroke>(st));
+    EXPECT_EQ(s.ctl.settings().mode, SculptMode::Grab);
+    // A sphere smoothed shrinks a little (mean-curvature flow), and nothing else happens.
+    EXPECT_GT(differingVoxels(*before, s.doc.grid()), 100u);
+    EXPECT_LT(s.ctl.volume(), volume);
+    EXPECT_GT(s.ctl.volume(), 0.99 * volume);
+    EXPECT_TRUE(s.doc.canUndo());
+}
+
+TEST(SculptController, FSizesTheBrushInTheViewAndShiftFItsStrength) {
+    Bench s;
+    const double x = kWidth / 2.0, y = kHeight / 2.0;
+    s.ctl.onMove(x, y);
+    const double radius = s.ctl.settings().radius;
+    // F, a move of 80 pixels, Esc: the radius is put back.
+    s.ctl.onKey('F', false, false);
+    ASSERT_EQ(s.ctl.sizing(), Sizing::Radius);
+    s.ctl.onMove(x + 80, y);
+    EXPECT_NE(s.ctl.settings().radius, radius);
+    s.ctl.onKey(GLFW_KEY_ESCAPE, false, false);
+    EXPECT_EQ(s.ctl.sizing(), Sizing::None);
+    EXPECT_EQ(s.ctl.settings().radius, radius);
+    // F, a move, a click: the radius is the move's length in the view plane at the surface
+    // point under the cursor, twice as long for twice the pixels; the click sculpts nothing.
+    const std::optional<glm::dvec3> at = s.ctl.pick(x, y);
+    ASSERT_TRUE(at);
+    double sized[2];
+    for (int k = 0; k < 2; ++k) {
+        s.ctl.onMove(x, y);
+        s.ctl.onKey('F', false, false);
+        s.ctl.onMove(x + 40 * (k + 1), y);
+        s.ctl.onButton(0, true, x + 40 * (k + 1), y, false);
+        s.ctl.onButton(0, false, x + 40 * (k + 1), y, false);
+        EXPECT_EQ(s.ctl.sizing(), Sizing::None);
+        sized[k] = s.ctl.settings().radius;
+        EXPECT_NEAR(sized[k],
+                    glm::length(s.ctl.camera().dragInViewPlane(*at, x, y, x + 40 * (k + 1), y,
+                                                               kWidth, kHeight)),
+                    1e-12);
+    }
+    EXPECT_NEAR(sized[1], 2.0 * sized[0], 1e-9);
+    EXPECT_TRUE(s.doc.script().strokes.empty());
+    // Shift-F: a fifth of the window's height is full strength.
+    s.ctl.onMove(x, y);
+    s.ctl.onKey('F', false, true);
+    ASSERT_EQ(s.ctl.sizing(), Sizing::Strength);
+    s.ctl.onMove(x, y + 0.1 * kHeight);
+    s.ctl.onButton(0, true, x, y + 0.1 * kHeight, false);
+    EXPECT_NEAR(s.ctl.settings().strength, 0.5, 1e-12);
+    EXPECT_TRUE(s.doc.script().strokes.empty());
+}
+
+TEST(SculptController, AGrabAtHalfStrengthMovesThePointUnderTheBrushHalfAsFar) {
+    // Grabbed at the top of the sphere's outline (where the surface faces up, in the view
+    // plane) and pulled up: the point under the brush, which moves with the ball, is the tip
+    // of what the grab pulls out. It is found on the grid: the first surface on the way down
+    // from well above it.
+    const double x = kWidth / 2.0;
+    double moved[2];
+    for (int k = 0; k < 2; ++k) {
+        Bench s;
+        s.ctl.settings().strength = k == 0 ? 1.0 : 0.5;
+        double y = kHeight / 2.0;
+        while (s.ctl.pick(x, y - 1))
+            --y; // the outline's top pixel
+        y += 2;
+        const glm::dvec3 p0 = *s.ctl.pick(x, y);
+        const glm::dvec3 hand =
+            s.ctl.camera().dragInViewPlane(p0, x, y, x, y - 40, kWidth, kHeight);
+        dragOn(s.ctl, x, y, x, y - 40, 4);
+        const glm::dvec3 expected = p0 + s.ctl.settings().strength * hand;
+        const auto hit = raycastLevelSet(s.doc.grid(), toEigen3(p0 + 2.0 * hand),
+                                         toEigen3(-glm::normalize(hand)), 100.0);
+        ASSERT_TRUE(hit);
+        const glm::dvec3 found(hit->x(), hit->y(), hit->z());
+        const double h = s.doc.grid().voxelSize()[0];
+        EXPECT_LT(glm::length(found - expected), h) << "strength " << s.ctl.settings().strength;
+        moved[k] = glm::length(found - p0);
+    }
+    std::printf("[ strength ] the point under the brush moved %.4f at strength 1, %.4f at 0.5\n",
+                moved[0], moved[1]);
+    EXPECT_NEAR(moved[1], 0.5 * moved[0], 1.0 / 32);
+}
+
+TEST(SculptController, RadialCopiesOfAGrabAreSymmetric) {
+    // Five copies about y: the grid at the surface and the same points turned by 72 degrees
+    // agree (trilinear), and the view shows a circle at each copy.
+    Bench s;
+    s.ctl.settings().radialCount = 5;
+    s.ctl.settings().radialAxis = 1;
+    const double x = kWidth / 2.0 + 60, y = kHeight / 2.0;
+    dragOn(s.ctl, x, y, x + 30, y - 30, 3);
+    const auto& sweep = std::get<SweepStroke>(s.doc.script().strokes.back());
+    EXPECT_EQ(sweep.radial.count, 5);
+    const Grid& g = s.doc.grid();
+    const double h = g.voxelSize()[0];
+    const Eigen::AngleAxisd turn(2.0 * M_PI / 5, Eigen::Vector3d::UnitY());
+    openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
+        g.getConstAccessor(), g.transform());
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (auto it = g.cbeginValueOn(); it; ++it) {
+        if (std::abs(*it) > h) continue;
+        const Eigen::Vector3d p = toEigen(g.indexToWorld(it.getCoord())), q = turn * p;
+        const double d = (double(*it) - sampler.wsSample(openvdb::Vec3d(q.x(), q.y(), q.z()))) / h;
+        sum += d * d;
+        ++n;
+    }
+    const double rms = std::sqrt(sum / double(n));
+    std::printf("[ radial ] 5 copies: %.4f voxel RMS between the surface and itself turned\n", rms);
+    EXPECT_LT(rms, 0.05);
+    EXPECT_EQ(s.ctl.symmetryPreview(glm::dvec3(0.5, 0.2, 0.3)).size(), 4u * 2 * 48);
 }
