@@ -131,14 +131,6 @@ RadialSymmetry SculptController::radial() const {
     return r;
 }
 
-std::vector<Eigen::Affine3d> SculptController::radialTurns() const {
-    const RadialSymmetry r = radial();
-    std::vector<Eigen::Affine3d> turns;
-    for (int k = 0; k < r.count; ++k)
-        turns.emplace_back(Eigen::AngleAxisd(2.0 * M_PI * k / r.count, r.axis));
-    return turns;
-}
-
 void SculptController::useToolFile(const std::string& path) {
     BakedToolSource source;
     source.kind = isMeshPath(path) ? BakedToolSource::Kind::Mesh : BakedToolSource::Kind::Vdb;
@@ -234,20 +226,12 @@ void SculptController::stepTopologyDrag() {
 void SculptController::dab(const glm::dvec3& p) {
     const double depth = (inverted_ ? 1.0 : 0.5) * settings_.radius;
     const glm::dvec3 in = p + depth * glm::normalize(p - camera_.eye());
-    std::vector<InflateStroke> strokes;
-    for (const Eigen::Affine3d& turn : radialTurns()) {
-        InflateStroke stroke{turn * toEigen3(in), settings_.radius};
-        stroke.strength = settings_.strength;
-        stroke.remove = inverted_;
-        strokes.push_back(stroke);
-    }
+    InflateStroke stroke{toEigen3(in), settings_.radius};
+    stroke.strength = settings_.strength;
+    stroke.remove = inverted_;
+    stroke.radial = radial();
     Document* doc = doc_;
-    launch([doc, strokes] {
-        SegmentReport r;
-        for (const InflateStroke& s : strokes)
-            r = doc->applyStroke(s);
-        return r;
-    });
+    launch([doc, stroke] { return doc->applyStroke(stroke); });
     lastDab_ = p;
     dabX_ = cursorX_;
     dabY_ = cursorY_;
@@ -261,11 +245,10 @@ void SculptController::smoothDab(const glm::dvec3& p) {
     stroke.tool.size = Eigen::Vector3d::Constant(settings_.radius);
     stroke.tool.falloff = settings_.falloff;
     stroke.strength = settings_.strength;
-    for (const Eigen::Affine3d& turn : radialTurns()) {
-        Placement at;
-        at.t = turn * toEigen3(p);
-        stroke.tool.path.push_back(at);
-    }
+    stroke.radial = radial();
+    Placement at;
+    at.t = toEigen3(p);
+    stroke.tool.path = {at};
     Document* doc = doc_;
     launch([doc, stroke] { return doc->applyStroke(stroke); });
     lastDab_ = p;
@@ -616,9 +599,13 @@ std::vector<glm::dvec3> SculptController::symmetryPreview(const glm::dvec3& cent
     std::vector<glm::dvec3> lines;
     const glm::dvec3 facing = glm::normalize(camera_.eye() - camera_.target);
     std::vector<glm::dvec3> copies;
-    for (const Eigen::Affine3d& turn : radialTurns())
-        copies.push_back(toGlm(turn * toEigen3(centre)));
-    if (settings_.mirror != MirrorAxis::None) {
+    const RadialSymmetry r = radial();
+    for (int k = 0; k < r.count; ++k)
+        copies.push_back(toGlm(r.turn(k) * toEigen3(centre)));
+    // Mirror planes copy the sweeps (grab, twist, inflate) only.
+    const SculptMode m = settings_.mode;
+    const bool sweeps = m == SculptMode::Grab || m == SculptMode::Twist || m == SculptMode::Inflate;
+    if (settings_.mirror != MirrorAxis::None && sweeps) {
         const int axis = int(settings_.mirror) - 1;
         for (std::size_t k = 0, n = copies.size(); k < n; ++k) {
             glm::dvec3 m = copies[k];

@@ -174,8 +174,7 @@ class SculptController {
     void collect();
     void dab(const glm::dvec3& p);
     void smoothDab(const glm::dvec3& p);
-    // The radial copies of a world transform (the identity first), as the panel sets them.
-    std::vector<Eigen::Affine3d> radialTurns() const;
+    // The radial symmetry the panel sets (about an axis through the origin).
     RadialSymmetry radial() const;
     void beginSizing(Sizing what);
     void moveSizing(double x, double y);

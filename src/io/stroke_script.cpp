@@ -45,9 +45,9 @@ const std::pair<const char*, std::vector<const char*>> kScriptFields[] = {
     {"placement", {"t", "r", "s"}},
     {"keyed placement", {"time"}},
     {"baked shape", {"vdb", "mesh", "grid", "voxel_size"}},
-    {"swirl", {"type", "at", "move", "radius", "ring", "swirls", "ball", "strength"}},
-    {"inflate", {"type", "at", "radius", "strength", "remove"}},
-    {"smooth", {"type", "tool", "strength"}},
+    {"swirl", {"type", "at", "move", "radius", "ring", "swirls", "ball", "strength", "radial"}},
+    {"inflate", {"type", "at", "radius", "strength", "remove", "radial"}},
+    {"smooth", {"type", "tool", "strength", "radial"}},
     {"pinch or strangle", {"type", "at", "axis", "size", "falloff", "open"}},
     {"keyframed", {"type", "tool", "keys"}},
     {"slide", {"type", "mirror", "tools", "keys"}},
@@ -256,6 +256,23 @@ double readStrength(const Reader& r, const json& v, const std::string& at) {
     return s;
 }
 
+// A stroke's "radial" symmetry: the stroke alone when not given.
+RadialSymmetry readRadial(const Reader& r, const json& v, const std::string& at) {
+    RadialSymmetry radial;
+    const auto it = v.find("radial");
+    if (it == v.end()) return radial;
+    const std::string where = at + "/radial";
+    r.onlyKeys(*it, where, "radial");
+    radial.axis = r.vec3(r.require(*it, where, "axis"), where + "/axis");
+    if (!(radial.axis.norm() > 0.0)) r.fail(where + "/axis", "an axis needs a length");
+    radial.center = r.vec3(r.require(*it, where, "center"), where + "/center");
+    const json& count = r.require(*it, where, "count");
+    if (!count.is_number_integer() || count.get<long long>() < 1 || count.get<long long>() > 64)
+        r.fail(where + "/count", "expected a whole number from 1 to 64");
+    radial.count = count.get<int>();
+    return radial;
+}
+
 SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "sweep");
     SweepStroke s;
@@ -271,17 +288,7 @@ SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
         else
             r.fail(at + "/mirror", "expected \"x\", \"y\" or \"z\"");
     }
-    if (auto it = v.find("radial"); it != v.end()) {
-        const std::string where = at + "/radial";
-        r.onlyKeys(*it, where, "radial");
-        s.radial.axis = r.vec3(r.require(*it, where, "axis"), where + "/axis");
-        if (!(s.radial.axis.norm() > 0.0)) r.fail(where + "/axis", "an axis needs a length");
-        s.radial.center = r.vec3(r.require(*it, where, "center"), where + "/center");
-        const json& count = r.require(*it, where, "count");
-        if (!count.is_number_integer() || count.get<long long>() < 1 || count.get<long long>() > 64)
-            r.fail(where + "/count", "expected a whole number from 1 to 64");
-        s.radial.count = count.get<int>();
-    }
+    s.radial = readRadial(r, v, at);
     const json& tools = r.require(v, at, "tools");
     if (!tools.is_array() || tools.empty())
         r.fail(at + "/tools", "expected a non-empty array of tools");
@@ -384,6 +391,7 @@ SwirlStroke readSwirl(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "swirl");
     SwirlStroke s;
     s.strength = readStrength(r, v, at);
+    s.radial = readRadial(r, v, at);
     s.at = r.vec3(r.require(v, at, "at"), at + "/at");
     s.move = r.vec3(r.require(v, at, "move"), at + "/move");
     s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
@@ -415,6 +423,7 @@ InflateStroke readInflate(const Reader& r, const json& v, const std::string& at)
     r.onlyKeys(v, at, "inflate");
     InflateStroke s;
     s.strength = readStrength(r, v, at);
+    s.radial = readRadial(r, v, at);
     s.at = r.vec3(r.require(v, at, "at"), at + "/at");
     s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
     if (auto it = v.find("remove"); it != v.end()) {
@@ -429,6 +438,7 @@ SmoothStroke readSmooth(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "smooth");
     SmoothStroke s;
     s.strength = readStrength(r, v, at);
+    s.radial = readRadial(r, v, at);
     s.tool = readTool(r, r.require(v, at, "tool"), at + "/tool", nullptr, 1);
     if (s.tool.shape != ToolShapeKind::Ball) r.fail(at + "/tool/shape", "smoothing takes a ball");
     return s;
@@ -779,6 +789,14 @@ json toolJson(const ToolSpec& t, bool withPath) {
     return tj;
 }
 
+// A stroke's radial symmetry, where it has copies.
+void radialJson(json& j, const RadialSymmetry& radial) {
+    if (radial.count > 1)
+        j["radial"] = {{"axis", vecJson(radial.axis)},
+                       {"center", vecJson(radial.center)},
+                       {"count", radial.count}};
+}
+
 json toolsJson(const SweepStroke& sweep) {
     json tools = json::array();
     for (const ToolSpec& t : sweep.tools)
@@ -823,10 +841,7 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             if (sw->mirror != MirrorAxis::None) j["mirror"] = mirrorName(sw->mirror);
             j["tools"] = toolsJson(*sw);
             if (sw->strength != 1.0) j["strength"] = sw->strength;
-            if (sw->radial.count > 1)
-                j["radial"] = {{"axis", vecJson(sw->radial.axis)},
-                               {"center", vecJson(sw->radial.center)},
-                               {"count", sw->radial.count}};
+            radialJson(j, sw->radial);
         } else if (const auto* sr = std::get_if<SwirlStroke>(&stroke)) {
             j["type"] = "swirl";
             j["at"] = vecJson(sr->at);
@@ -836,16 +851,19 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             j["swirls"] = sr->swirls;
             if (sr->ball > 0.0) j["ball"] = sr->ball;
             if (sr->strength != 1.0) j["strength"] = sr->strength;
+            radialJson(j, sr->radial);
         } else if (const auto* in = std::get_if<InflateStroke>(&stroke)) {
             j["type"] = "inflate";
             j["at"] = vecJson(in->at);
             j["radius"] = in->radius;
             if (in->strength != 1.0) j["strength"] = in->strength;
             if (in->remove) j["remove"] = true;
+            radialJson(j, in->radial);
         } else if (const auto* sm = std::get_if<SmoothStroke>(&stroke)) {
             j["type"] = "smooth";
             j["tool"] = toolJson(sm->tool, true);
             if (sm->strength != 1.0) j["strength"] = sm->strength;
+            radialJson(j, sm->radial);
         } else if (const auto* pinch = std::get_if<PinchStroke>(&stroke)) {
             j = topologyToolJson("pinch", *pinch);
         } else if (const auto* strangle = std::get_if<StrangleStroke>(&stroke)) {

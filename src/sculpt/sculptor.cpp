@@ -75,7 +75,8 @@ SegmentReport Sculptor::applyStroke(const Stroke& stroke,
                                     const std::function<void(const SegmentReport&)>& each) {
     SegmentReport last;
     if (const auto* smooth = std::get_if<SmoothStroke>(&stroke)) {
-        for (std::size_t k = 0; k < smooth->tool.path.size(); ++k) {
+        const std::size_t dabs = smooth->tool.path.size() * std::size_t(smooth->radial.count);
+        for (std::size_t k = 0; k < dabs; ++k) {
             last = applySmoothDab(smoothDab(*smooth, k));
             last.segment = k;
             if (each) each(last);

@@ -14,6 +14,12 @@ template <class... F> struct Overloaded : F... { using F::operator()...; };
 template <class... F> Overloaded(F...) -> Overloaded<F...>;
 } // namespace
 
+Eigen::Affine3d RadialSymmetry::turn(int k) const {
+    return Eigen::Translation3d(center) *
+           Eigen::AngleAxisd(2.0 * M_PI * k / count, axis.normalized()) *
+           Eigen::Translation3d(-center);
+}
+
 Sweep toSweep(const SweepStroke& stroke) {
     Sweep sweep;
     sweep.mirror = stroke.mirror;
@@ -54,10 +60,7 @@ Sweep toSweep(const SweepStroke& stroke) {
     if (radial.count > 1) {
         const std::size_t originals = sweep.tools.size();
         for (int k = 1; k < radial.count; ++k) {
-            const double angle = 2.0 * M_PI * k / radial.count;
-            const Eigen::Affine3d turn = Eigen::Translation3d(radial.center) *
-                                         Eigen::AngleAxisd(angle, radial.axis.normalized()) *
-                                         Eigen::Translation3d(-radial.center);
+            const Eigen::Affine3d turn = radial.turn(k);
             for (std::size_t i = 0; i < originals; ++i) {
                 SweptTool copy = sweep.tools[i];
                 for (Placement& p : copy.path) {
@@ -74,10 +77,11 @@ Sweep toSweep(const SweepStroke& stroke) {
     return sweep;
 }
 
-SwirlSpec toSwirl(const SwirlStroke& stroke) {
+SwirlSpec toSwirl(const SwirlStroke& stroke, int copy) {
+    const Eigen::Affine3d turn = stroke.radial.turn(copy);
     SwirlSpec s;
-    s.at = stroke.at;
-    s.move = stroke.strength * stroke.move;
+    s.at = turn * stroke.at;
+    s.move = stroke.strength * (turn.linear() * stroke.move);
     s.radius = stroke.radius;
     s.ring = stroke.ring;
     s.swirls = stroke.swirls;
@@ -121,7 +125,9 @@ std::vector<std::unique_ptr<StepDeformation>> planKeyedStroke(const Stroke& stro
 
 SmoothBrush smoothDab(const SmoothStroke& stroke, std::size_t k) {
     SmoothBrush b;
-    b.center = stroke.tool.path.at(k).t;
+    const int n = stroke.radial.count;
+    b.center =
+        stroke.radial.turn(int(k % std::size_t(n))) * stroke.tool.path.at(k / std::size_t(n)).t;
     b.radius = stroke.tool.size.x();
     b.falloff = stroke.tool.falloff;
     b.time = stroke.strength * kSmoothTimePerRadius2 * b.radius * b.radius;
@@ -140,7 +146,12 @@ std::size_t segmentCount(const Stroke& stroke, double voxelSize) {
         return std::size_t(std::max(1, flow->segments));
     if (const auto* fluid = std::get_if<FluidStroke>(&stroke))
         return fluid->path.size() < 2 ? 0 : fluid->path.size() - 1;
-    if (const auto* smooth = std::get_if<SmoothStroke>(&stroke)) return smooth->tool.path.size();
+    if (const auto* smooth = std::get_if<SmoothStroke>(&stroke))
+        return smooth->tool.path.size() * std::size_t(smooth->radial.count);
+    if (const auto* swirl = std::get_if<SwirlStroke>(&stroke))
+        return std::size_t(swirl->radial.count);
+    if (const auto* inflate = std::get_if<InflateStroke>(&stroke))
+        return std::size_t(inflate->radial.count);
     return 1;
 }
 
@@ -158,14 +169,21 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                     parts.push_back(std::make_unique<SweepSegment>(sweep, k));
             },
             [&](const SwirlStroke& s) {
-                if (s.ball > 0.0)
-                    parts.push_back(starShapedSwirl(toSwirl(s), s.ball, reach()));
-                else
-                    parts.push_back(std::make_unique<SwirlSegment>(toSwirl(s)));
+                for (int k = 0; k < s.radial.count; ++k) {
+                    if (s.ball > 0.0)
+                        parts.push_back(starShapedSwirl(toSwirl(s, k), s.ball, reach()));
+                    else
+                        parts.push_back(std::make_unique<SwirlSegment>(toSwirl(s, k)));
+                }
             },
             [&](const InflateStroke& s) {
-                parts.push_back(
-                    std::make_unique<Inflation>(s.at, s.strength * s.radius, reach(), s.remove));
+                // Planned on the shape as it is before the first copy: each copy may grow it
+                // by its ball, which the later copies' reach takes in.
+                const double rho = s.strength * s.radius;
+                const Box around = reach().expanded(2.0 * rho * (s.radial.count - 1));
+                for (int k = 0; k < s.radial.count; ++k)
+                    parts.push_back(std::make_unique<Inflation>(s.radial.turn(k) * s.at, rho,
+                                                                around, s.remove));
             },
             [&](const PinchStroke& s) { parts = planPinch(s, grid.voxelSize()[0]); },
             [&](const StrangleStroke& s) { parts = planStrangle(s, grid.voxelSize()[0]); },

@@ -79,12 +79,15 @@ struct ToolSpec {
     std::shared_ptr<const ToolShape> baked;
 };
 
-// N copies of each tool, turned about the axis through the centre by multiples of 360/N
-// degrees, swept together with it (1: the tool alone).
+// N copies of a stroke, turned about the axis through the centre by multiples of 360/N
+// degrees (1: the stroke alone). A sweep's copies are tools swept together with its own;
+// a swirl's, an inflation's and a smooth dab's are applied one after another.
 struct RadialSymmetry {
     Eigen::Vector3d axis = Eigen::Vector3d::UnitY();
     Eigen::Vector3d center = Eigen::Vector3d::Zero();
     int count = 1;
+    // Copy k: the turn by k 360/N degrees about the axis through the centre.
+    Eigen::Affine3d turn(int k) const;
 };
 
 // A stroke's strength (0, 1]: the fraction of the hand's motion a sweep applies, of a
@@ -104,6 +107,7 @@ struct SwirlStroke {
     int swirls = 8;
     double ball = 0.0; // > 0: star-shaped swirl carrying a ball of this radius (4.19)
     double strength = 1.0;
+    RadialSymmetry radial{};
 };
 
 // remove: the ball is sucked back into its centre instead (2.31, the inverse inflation):
@@ -113,6 +117,7 @@ struct InflateStroke {
     double radius = 0.1;
     double strength = 1.0;
     bool remove = false;
+    RadialSymmetry radial{};
 };
 
 struct PinchStroke : PinchSpec {};
@@ -161,6 +166,7 @@ struct FluidStroke {
 struct SmoothStroke {
     ToolSpec tool; // a ball
     double strength = 1.0;
+    RadialSymmetry radial{}; // each dab's copies follow it
 };
 
 using Stroke = std::variant<SweepStroke, SwirlStroke, InflateStroke, PinchStroke, StrangleStroke,
@@ -176,14 +182,15 @@ struct StrokeScript {
     std::vector<double> durations;
 };
 
-// Dab k of a smooth stroke as a brush.
+// Dab k of a smooth stroke as a brush (the dabs at each placement: the placement's, then
+// its radial copies).
 SmoothBrush smoothDab(const SmoothStroke& stroke, std::size_t k);
 
 // The deformation a sweep stroke describes. Throws std::invalid_argument for a baked tool
 // that was not loaded.
 Sweep toSweep(const SweepStroke& stroke);
-// The swirl ring a swirl stroke describes.
-SwirlSpec toSwirl(const SwirlStroke& stroke);
+// The swirl ring a swirl stroke describes (radial copy k of it).
+SwirlSpec toSwirl(const SwirlStroke& stroke, int copy = 0);
 
 // Whether the stroke is keyed over time (keyframed, slide), and then how long it lasts (its
 // last key's time); 0 for other strokes.

@@ -236,31 +236,51 @@ def test_a_strength_is_kept_in_the_script_and_refused_outside_its_range():
                  "falloff": 0.4, "open": 0.3, "strength": 0.5})
 
 
-def radial_grab(count=None):
-    """A unit sphere at 1/32 with a bump pulled out off the y axis, radially repeated."""
-    sweep = {"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3,
-                                        "path": [{"t": [0.6, 0.8, 0]},
-                                                 {"t": [0.8, 1.1, 0.1]}]}]}
-    if count is not None:
-        sweep["radial"] = {"axis": [0, 1, 0], "center": [0, 0, 0], "count": count}
+RADIAL_STROKES = {
+    "sweep": {"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3,
+                                          "path": [{"t": [0.6, 0.8, 0]},
+                                                   {"t": [0.8, 1.1, 0.1]}]}]},
+    "inflate": {"type": "inflate", "at": [0.6, 0.7, 0.1], "radius": 0.2},
+    "swirl": {"type": "swirl", "at": [0.6, 0.8, 0], "move": [0.15, 0.2, 0.05], "radius": 0.2},
+    "smooth": {"type": "smooth", "tool": {"shape": "ball", "size": 0.3, "falloff": 0.1,
+                                          "path": [{"t": [0.6, 0.8, 0]}]}},
+}
+
+
+def radial_grab(count=None, kind="sweep"):
+    """A unit sphere at 1/32 with a stroke off the y axis (a bump pulled out, a ball of clay,
+    a swirl, a smooth dab, and then the stroke before it), radially repeated."""
+    stroke = dict(RADIAL_STROKES[kind])
+    if count:
+        stroke["radial"] = {"axis": [0, 1, 0], "center": [0, 0, 0], "count": count}
+    strokes = [stroke]
+    if kind == "smooth":  # something to smooth: the bump, five times (count 0: only that)
+        strokes = [dict(RADIAL_STROKES["sweep"], radial={"axis": [0, 1, 0], "center": [0, 0, 0],
+                                                        "count": 5})] + strokes[count == 0:]
     return sweepers.apply({"sweepers": 1, "grid": {"voxel_size": 1 / 32},
                            "start": {"sphere": {"center": [0, 0, 0], "radius": 1}},
-                           "strokes": [sweep]})
+                           "strokes": strokes})
 
 
-def test_radial_symmetry_makes_the_grid_symmetric():
-    shape = radial_grab(5)
+def turned_rms(shape, count):
+    """The RMS difference (voxels) between the grid at the voxels next to its surface and at
+    the same points turned by 360 / count degrees about y, sampled trilinearly."""
     h = shape.voxel_size
     grid = shape.to_pyopenvdb()
     near = [c for c, v in voxels(grid).items() if abs(v) < h]
     points = np.array([grid.transform.indexToWorld(c) for c in near])
-    turn = 2 * np.pi / 5  # about y: (x, z) turned
+    turn = 2 * np.pi / count  # about y: (x, z) turned
     turned = points.copy()
     turned[:, 0] = np.cos(turn) * points[:, 0] + np.sin(turn) * points[:, 2]
     turned[:, 2] = -np.sin(turn) * points[:, 0] + np.cos(turn) * points[:, 2]
-    rms = np.sqrt(np.mean((shape.sample(points) - shape.sample(turned)) ** 2)) / h
+    return np.sqrt(np.mean((shape.sample(points) - shape.sample(turned)) ** 2)) / h
+
+
+def test_radial_symmetry_makes_the_grid_symmetric():
+    shape = radial_grab(5)
+    rms = turned_rms(shape, 5)
     alone = radial_grab()
-    print(f"5-fold: {len(near)} voxels near the surface, RMS difference {rms:.4f} voxel; "
+    print(f"5-fold: RMS difference {rms:.4f} voxel; "
           f"volume {shape.volume:.4f} against {alone.volume:.4f} for one bump")
     assert rms < 0.05
     # Five bumps: the volume grows about five times as much as for one.
@@ -270,6 +290,38 @@ def test_radial_symmetry_makes_the_grid_symmetric():
     assert voxels(radial_grab(1).to_pyopenvdb()) == voxels(alone.to_pyopenvdb())
     with pytest.raises(ValueError, match="count"):
         radial_grab(65)
+
+
+@pytest.mark.parametrize("kind", ["inflate", "swirl", "smooth"])
+def test_radial_symmetry_on_clay_swirls_and_smoothing(kind):
+    # Their copies are applied one after another (they are no tools to sweep together):
+    # still 5-fold symmetric, and a count of 1 is the stroke alone.
+    shape, alone = radial_grab(5, kind), radial_grab(None, kind)
+    rms = turned_rms(shape, 5)
+    print(f"{kind}, 5-fold: RMS difference {rms:.4f} voxel (alone: {turned_rms(alone, 5):.4f})")
+    assert rms < 0.05
+    assert voxels(radial_grab(1, kind).to_pyopenvdb()) == voxels(alone.to_pyopenvdb())
+    if kind == "swirl":  # keeps the volume: one swirl alone is far from symmetric
+        assert turned_rms(alone, 5) > 4 * rms
+    elif kind == "inflate":  # five balls of clay: about five times the volume of one
+        start = 4 / 3 * np.pi
+        assert 4.0 < (shape.volume - start) / (alone.volume - start) < 6.0
+    else:  # each of the five dabs smooths its copy of the bump alike
+        bumps = radial_grab(0, "smooth")
+        rng = np.random.default_rng(3)
+        around = rng.uniform(-0.3, 0.3, size=(20000, 3))
+        changes = []
+        for k in range(5):
+            a = 2 * np.pi * k / 5
+            c = np.array([0.6 * np.cos(a), 0.8, -0.6 * np.sin(a)])
+            p = c + around
+            p = p[np.abs(bumps.sample(p)) < shape.voxel_size]  # next to the surface
+            d = shape.sample(p) - bumps.sample(p)
+            changes.append(np.sqrt(np.mean(d ** 2)) / shape.voxel_size)
+        print("  each copy's change, voxels RMS:", " ".join(f"{c:.3f}" for c in changes))
+        # (A dab moves a bump this well resolved by hundredths of a voxel; each copy of it
+        # moves, by about as much.)
+        assert min(changes) > 0.002 and max(changes) < 1.5 * min(changes)
 
 
 def test_smoothing_has_no_exact_shape_behind_it():

@@ -607,8 +607,9 @@ TEST(SculptController, RadialCopiesOfAGrabAreSymmetric) {
     const Grid& g = s.doc.grid();
     const double h = g.voxelSize()[0];
     const Eigen::AngleAxisd turn(2.0 * M_PI / 5, Eigen::Vector3d::UnitY());
+    const Grid::ConstAccessor acc = g.getConstAccessor(); // the sampler keeps a reference
     openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
-        g.getConstAccessor(), g.transform());
+        acc, g.transform());
     double sum = 0.0;
     std::size_t n = 0;
     for (auto it = g.cbeginValueOn(); it; ++it) {
