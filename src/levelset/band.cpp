@@ -94,7 +94,9 @@ BandReport checkBand(const Grid& grid) {
     openvdb::tools::CheckLevelSet<Grid> check(grid);
     r.vdbCheck = check.check(/*updateMask=*/false);
     const double h = grid.voxelSize()[0];
-    const float limit = float(grid.background() + h), inner = float(grid.background() - h);
+    // A voxel exactly a voxel inside the band's edge has its neighbour on the edge, which
+    // rounding puts on either side of it: a thousandth of a voxel keeps that from counting.
+    const float limit = float(grid.background() + h), inner = float(grid.background() - 1.001 * h);
     openvdb::tree::LeafManager<const Grid::TreeType> leaves(grid.tree());
     struct Counts {
         std::size_t active = 0, near = 0, unit = 0, beyond = 0, holes = 0;

@@ -25,8 +25,8 @@ struct BandReport {
     std::size_t nearInterface = 0; // active voxels within one voxel of the zero crossing
     std::size_t unitGradient = 0;  // ... of which |grad phi| lies in [0.9, 1.1]
     std::size_t beyondBand = 0;    // active voxels with |phi| > half-width + 1 voxel
-    std::size_t bandHoles = 0;     // active voxels with |phi| < half-width - 1 voxel next to
-                                   // an inactive one (the band is missing a voxel it must hold)
+    std::size_t bandHoles = 0;     // active voxels with |phi| < half-width - 1.001 voxel next
+                                   // to an inactive one (the band misses a voxel it must hold)
     std::string vdbCheck;          // tools::checkLevelSet's complaint, empty when none
     double unitGradientFraction() const {
         return nearInterface ? double(unitGradient) / double(nearInterface) : 1.0;

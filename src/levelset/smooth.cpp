@@ -7,6 +7,7 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include "core/falloff.h"
+#include "levelset/dilate.h"
 #include "levelset/fast_marching.h"
 #include "levelset/parallel.h"
 
@@ -17,22 +18,47 @@ namespace {
 using Leaf = Grid::TreeType::LeafNodeType;
 
 // A leaf's values and the layer of voxels around it (10 x 10 x 10, x slowest): the
-// stencils of a step read this block instead of the tree.
+// stencils of a step read this block instead of the tree. The 26 leaves around are found
+// once (their buffers, or the one value of a tile or of empty space) and read directly.
 struct PaddedLeaf {
     std::array<float, 1000> v;
     float at(int x, int y, int z) const {
         return v[std::size_t((x + 1) * 100 + (y + 1) * 10 + z + 1)];
     }
-    void load(const Leaf& leaf, const Grid::ConstAccessor& acc) {
-        const openvdb::Coord o = leaf.origin();
-        for (int x = -1; x <= 8; ++x)
-            for (int y = -1; y <= 8; ++y)
-                for (int z = -1; z <= 8; ++z) {
-                    const bool inside = x >= 0 && x < 8 && y >= 0 && y < 8 && z >= 0 && z < 8;
-                    v[std::size_t((x + 1) * 100 + (y + 1) * 10 + z + 1)] =
-                        inside ? leaf.getValue(Leaf::coordToOffset(o.offsetBy(x, y, z)))
-                               : acc.getValue(o.offsetBy(x, y, z));
+
+    struct Around {
+        std::array<const float*, 27> buffer; // (dx + 1) * 9 + (dy + 1) * 3 + dz + 1
+        std::array<float, 27> value;         // where there is no leaf
+    };
+    static Around around(const Grid& grid, const Leaf& leaf) {
+        Around a;
+        const Grid::ConstAccessor acc = grid.getConstAccessor();
+        for (int dx = -1; dx <= 1; ++dx)
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dz = -1; dz <= 1; ++dz) {
+                    const std::size_t k = std::size_t((dx + 1) * 9 + (dy + 1) * 3 + dz + 1);
+                    const openvdb::Coord o = leaf.origin().offsetBy(8 * dx, 8 * dy, 8 * dz);
+                    const Leaf* n = grid.tree().probeConstLeaf(o);
+                    a.buffer[k] = n ? n->buffer().data() : nullptr;
+                    a.value[k] = n ? 0.0f : acc.getValue(o);
                 }
+        return a;
+    }
+
+    void load(const Around& a) {
+        for (int x = -1; x <= 8; ++x) {
+            const int nx = x < 0 ? 0 : x > 7 ? 2 : 1, lx = (x + 8) & 7;
+            for (int y = -1; y <= 8; ++y) {
+                const int ny = y < 0 ? 0 : y > 7 ? 2 : 1, ly = (y + 8) & 7;
+                for (int z = -1; z <= 8; ++z) {
+                    const int nz = z < 0 ? 0 : z > 7 ? 2 : 1, lz = (z + 8) & 7;
+                    const std::size_t k = std::size_t(nx * 9 + ny * 3 + nz);
+                    const float* b = a.buffer[k];
+                    v[std::size_t((x + 1) * 100 + (y + 1) * 10 + z + 1)] =
+                        b ? b[lx * 64 + ly * 8 + lz] : a.value[k];
+                }
+            }
+        }
     }
 };
 
@@ -71,11 +97,17 @@ CurvatureSmoother::CurvatureSmoother(Grid& grid, const SmoothBrush& brush, Inter
                                 openvdb::Coord::ceil(c + openvdb::Vec3d(margin)));
 }
 
+double CurvatureSmoother::renormalizedRadius() const {
+    return reachRadius() / grid_.voxelSize()[0] - 1.0;
+}
+
 SmoothStats CurvatureSmoother::run() {
     stats_ = SmoothStats();
     stats_.changed = reach_;
     if (!(brush_.time > 0.0) || !(brush_.radius > 0.0)) return stats_;
     collectLeaves();
+    weigh();
+    widenBand();
     pollInterrupt(interrupter_);
     flow();
     pollInterrupt(interrupter_);
@@ -94,6 +126,62 @@ void CurvatureSmoother::collectLeaves() {
     stats_.leaves = leaves_.size();
 }
 
+void CurvatureSmoother::weigh() {
+    const double r = brush_.radius, f = brush_.falloff;
+    const float bg = grid_.background();
+    // Band voxels (not the +-background of those just taken in) within the falloff's reach.
+    std::vector<std::array<float, Leaf::SIZE>> weight(leaves_.size());
+    std::vector<char> reached(leaves_.size(), 0);
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves_.size()), [&](const auto& range) {
+        for (std::size_t l = range.begin(); l != range.end(); ++l) {
+            const Leaf& leaf = *leaves_[l];
+            for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
+                weight[l][i] = 0.0f;
+                if (!leaf.isValueOn(i) || std::abs(leaf.getValue(i)) >= bg) continue;
+                const openvdb::Vec3d w = grid_.indexToWorld(leaf.offsetToGlobalCoord(i));
+                const double d = (Eigen::Vector3d(w.x(), w.y(), w.z()) - brush_.center).norm() - r;
+                weight[l][i] = float(falloffMu(d, f));
+                reached[l] |= weight[l][i] > 0.0f;
+            }
+        }
+    });
+    flowing_.clear();
+    weight_.clear();
+    weighted_.clear();
+    for (std::size_t l = 0; l < leaves_.size(); ++l) {
+        if (!reached[l]) continue;
+        flowing_.push_back(l);
+        weight_.push_back(weight[l]);
+        LeafVoxels lv{leaves_[l]->origin(), {}};
+        for (openvdb::Index i = 0; i < Leaf::SIZE; ++i)
+            if (weight[l][i] > 0.0f) lv.words[i >> 6] |= leafwords::Word(1) << (i & 63);
+        weighted_.push_back(lv);
+    }
+}
+
+// A dab may move the surface by two voxels: the band grows by two voxels around the voxels
+// that flow (within the renormalized ball), so that the renormalization finds band on
+// whichever side the surface moved to. The new voxels keep the value they held
+// (+-background, of the right sign) and take no part in the flow; the renormalization gives
+// them distances, or drops them past the half-width.
+void CurvatureSmoother::widenBand() {
+    const openvdb::Vec3d c =
+        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+    const double r = renormalizedRadius();
+    for (const LeafVoxels& lv : dilatedByCube(weighted_, 2)) {
+        Leaf* leaf = grid_.tree().probeLeaf(lv.origin);
+        const bool made = !leaf;
+        for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
+            if (!((lv.words[i >> 6] >> (i & 63)) & 1)) continue;
+            if (((lv.origin + Leaf::offsetToLocalCoord(i)).asVec3d() - c).lengthSqr() > r * r)
+                continue;
+            if (!leaf) leaf = grid_.tree().touchLeaf(lv.origin);
+            leaf->setValueOn(i);
+        }
+        if (made && leaf) leaves_.push_back(leaf); // renormalized with the others
+    }
+}
+
 void CurvatureSmoother::flow() {
     const double h = grid_.voxelSize()[0];
     // Explicit steps of the central scheme are stable for dt <= h^2 / 4: along the surface
@@ -106,56 +194,38 @@ void CurvatureSmoother::flow() {
     // The whole band flows, so that the differences read consistent values; no value moves
     // more than two voxels in a dab, so the surface stays inside the band that holds it.
     const float most = float(2.0 * h);
-    const double r = brush_.radius, f = brush_.falloff;
-    // The weights, and the leaves with an active voxel the brush reaches: only those flow.
-    std::vector<std::array<float, Leaf::SIZE>> weight(leaves_.size());
-    std::vector<char> reached(leaves_.size(), 0);
-    parallelFor(tbb::blocked_range<std::size_t>(0, leaves_.size()), [&](const auto& range) {
-        for (std::size_t l = range.begin(); l != range.end(); ++l) {
-            const Leaf& leaf = *leaves_[l];
-            for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
-                weight[l][i] = 0.0f;
-                if (!leaf.isValueOn(i)) continue;
-                const openvdb::Vec3d w = grid_.indexToWorld(leaf.offsetToGlobalCoord(i));
-                const double d = (Eigen::Vector3d(w.x(), w.y(), w.z()) - brush_.center).norm() - r;
-                weight[l][i] = float(falloffMu(d, f));
-                reached[l] |= weight[l][i] > 0.0f;
-            }
-        }
-    });
-    std::vector<std::size_t> flowing;
-    for (std::size_t l = 0; l < leaves_.size(); ++l)
-        if (reached[l]) flowing.push_back(l);
-    std::vector<std::array<float, Leaf::SIZE>> next(flowing.size()), start(flowing.size());
-    for (std::size_t k = 0; k < flowing.size(); ++k) {
-        const float* values = leaves_[flowing[k]]->buffer().data();
+    std::vector<std::array<float, Leaf::SIZE>> next(flowing_.size()), start(flowing_.size());
+    for (std::size_t k = 0; k < flowing_.size(); ++k) {
+        const float* values = leaves_[flowing_[k]]->buffer().data();
         std::copy(values, values + Leaf::SIZE, start[k].begin());
     }
+    std::vector<PaddedLeaf::Around> around(flowing_.size());
+    parallelFor(tbb::blocked_range<std::size_t>(0, flowing_.size()), [&](const auto& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+            around[k] = PaddedLeaf::around(grid_, *leaves_[flowing_[k]]);
+    });
     tbb::enumerable_thread_specific<std::size_t> updates(0);
     for (int s = 0; s < steps; ++s) {
-        parallelFor(tbb::blocked_range<std::size_t>(0, flowing.size()), [&](const auto& range) {
-            const Grid::ConstAccessor acc = grid_.getConstAccessor();
+        parallelFor(tbb::blocked_range<std::size_t>(0, flowing_.size()), [&](const auto& range) {
             PaddedLeaf block;
             std::size_t n = 0;
             for (std::size_t k = range.begin(); k != range.end(); ++k) {
-                const std::size_t l = flowing[k];
-                const Leaf& leaf = *leaves_[l];
-                block.load(leaf, acc);
+                block.load(around[k]);
                 for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
                     const int x = int(i >> 6), y = int((i >> 3) & 7), z = int(i & 7);
                     const float p = block.at(x, y, z);
                     next[k][i] = p;
-                    if (weight[l][i] == 0.0f) continue;
-                    const double moved = p + dt * weight[l][i] * curvatureTerm(block, x, y, z, h);
+                    if (weight_[k][i] == 0.0f) continue;
+                    const double moved = p + dt * weight_[k][i] * curvatureTerm(block, x, y, z, h);
                     next[k][i] = std::clamp(float(moved), start[k][i] - most, start[k][i] + most);
                     ++n;
                 }
             }
             updates.local() += n;
         });
-        parallelFor(tbb::blocked_range<std::size_t>(0, flowing.size()), [&](const auto& range) {
+        parallelFor(tbb::blocked_range<std::size_t>(0, flowing_.size()), [&](const auto& range) {
             for (std::size_t k = range.begin(); k != range.end(); ++k)
-                std::copy(next[k].begin(), next[k].end(), leaves_[flowing[k]]->buffer().data());
+                std::copy(next[k].begin(), next[k].end(), leaves_[flowing_[k]]->buffer().data());
         });
         pollInterrupt(interrupter_);
     }
@@ -167,7 +237,7 @@ void CurvatureSmoother::renormalizeReach() {
     // box's corners too) but for an inactive voxel next to them that the band takes in.
     const openvdb::Vec3d c =
         grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
-    const double h = grid_.voxelSize()[0], r = reachRadius() / h - 1.0;
+    const double r = renormalizedRadius();
     VoxelList inside;
     inside.reserve(leaves_.size());
     for (const Leaf* leaf : leaves_) {

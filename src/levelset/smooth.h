@@ -14,12 +14,15 @@
 // renormalizes that box.
 #pragma once
 
+#include <array>
 #include <cstddef>
+#include <vector>
 
 #include <Eigen/Core>
 
 #include "levelset/interrupt.h"
 #include "levelset/vdb.h"
+#include "levelset/voxel_list.h"
 
 namespace sweepers {
 
@@ -54,15 +57,25 @@ class CurvatureSmoother {
     SmoothStats run();
 
   private:
+    // The ball renormalization recomputes: the reach less the voxel the band may take in
+    // next to it (in voxels, about the brush's centre).
+    double renormalizedRadius() const;
     void collectLeaves(); // the leaves of the band inside the reach
+    void weigh();         // the brush's weight at each band voxel, and the leaves that flow
+    void widenBand();     // two more voxels of band around the voxels that flow
     void flow();          // the explicit steps of the flow
     void renormalizeReach();
 
+    using Leaf = Grid::TreeType::LeafNodeType;
     Grid& grid_;
     SmoothBrush brush_;
     Interrupter* interrupter_;
     openvdb::CoordBBox reach_;
-    std::vector<Grid::TreeType::LeafNodeType*> leaves_;
+    std::vector<Leaf*> leaves_;
+    // Of the leaves that flow (index into leaves_): the weights, and the voxels with one.
+    std::vector<std::size_t> flowing_;
+    std::vector<std::array<float, Leaf::SIZE>> weight_;
+    VoxelList weighted_;
     SmoothStats stats_;
 };
 

@@ -6,11 +6,14 @@
 #include <cmath>
 
 #include <openvdb/math/Stencils.h>
+#include <openvdb/tools/LevelSetRebuild.h>
 
 #include "grids.h"
 #include "io/stroke_script.h"
 #include "io/study_files.h"
+#include "levelset/band.h"
 #include "levelset/fast_marching.h"
+#include "levelset/measure.h"
 #include "levelset/smooth.h"
 #include "sculpt/sculptor.h"
 #include "study/study.h"
@@ -32,9 +35,12 @@ GridPtr bumpySphere() {
         return p.norm() - kR -
                amplitude * std::sin(k * p.x()) * std::sin(k * p.y()) * std::sin(k * p.z() + 0.7);
     };
+    // Sampled in a wide band (the bumps' slopes make the function far from a distance),
+    // then rebuilt as the distance to its zero set in the usual band.
     const int n = int(std::ceil((kR + 0.2) / kH));
-    GridPtr g = test::gridFromSdf(sdf, kH, 3.0, {openvdb::Coord(-n), openvdb::Coord(n)});
-    renormalizeAll(*g);
+    const GridPtr wide = test::gridFromSdf(sdf, kH, 8.0, {openvdb::Coord(-n), openvdb::Coord(n)});
+    GridPtr g = openvdb::tools::levelSetRebuild(*wide, 0.0f, 3.0f);
+    markAsDocument(*g);
     return g;
 }
 
@@ -160,5 +166,23 @@ TEST(Smooth, AStudyOfAHistoryThatSmoothsMeasuresNoExactError) {
         EXPECT_EQ(std::isnan(back.error.rms), smooth);
         EXPECT_EQ(std::isnan(back.error.volumeError()), smooth);
         EXPECT_EQ(back.referenceTopologyKnown, !smooth);
+    }
+}
+
+TEST(Smooth, ManyDabsKeepAValidNarrowBand) {
+    // Dabs that overlap move the surface by more than the band holds around it at first:
+    // the band grows with it (no hole, nothing beyond it), and the topology stays a sphere's.
+    Sculptor sculptor(bumpySphere());
+    std::vector<Eigen::Vector3d> path;
+    for (int k = 0; k <= 8; ++k) {
+        const double a = -0.6 + 0.15 * k;
+        path.emplace_back(kR * std::sin(a), kR * std::cos(a), 0.1);
+    }
+    for (int pass = 0; pass < 3; ++pass) {
+        sculptor.applyStroke(dabsAt(path));
+        const BandReport r = checkBand(sculptor.grid());
+        EXPECT_EQ(r.bandHoles, 0u) << "pass " << pass;
+        EXPECT_EQ(r.beyondBand, 0u) << "pass " << pass;
+        EXPECT_EQ(topologicalEulerCharacteristic(sculptor.grid()), 2) << "pass " << pass;
     }
 }
