@@ -600,6 +600,7 @@ std::vector<glm::dvec3> SculptController::symmetryPreview(const glm::dvec3& cent
     const glm::dvec3 facing = glm::normalize(camera_.eye() - camera_.target);
     std::vector<glm::dvec3> copies;
     const RadialSymmetry r = radial();
+    copies.reserve(2 * std::size_t(r.count));
     for (int k = 0; k < r.count; ++k)
         copies.push_back(toGlm(r.turn(k) * toEigen3(centre)));
     // Mirror planes copy the sweeps (grab, twist, inflate) only.

@@ -22,9 +22,11 @@ using Leaf = Grid::TreeType::LeafNodeType;
 // once (their buffers, or the one value of a tile or of empty space) and read directly.
 struct PaddedLeaf {
     std::array<float, 1000> v;
-    float at(int x, int y, int z) const {
-        return v[std::size_t((x + 1) * 100 + (y + 1) * 10 + z + 1)];
+    // (x, y, z) from -1 to 8 each.
+    static std::size_t index(int x, int y, int z) {
+        return std::size_t(x + 1) * 100 + std::size_t(y + 1) * 10 + std::size_t(z + 1);
     }
+    float at(int x, int y, int z) const { return v[index(x, y, z)]; }
 
     struct Around {
         std::array<const float*, 27> buffer; // (dx + 1) * 9 + (dy + 1) * 3 + dz + 1
@@ -36,7 +38,8 @@ struct PaddedLeaf {
         for (int dx = -1; dx <= 1; ++dx)
             for (int dy = -1; dy <= 1; ++dy)
                 for (int dz = -1; dz <= 1; ++dz) {
-                    const std::size_t k = std::size_t((dx + 1) * 9 + (dy + 1) * 3 + dz + 1);
+                    const std::size_t k =
+                        std::size_t(dx + 1) * 9 + std::size_t(dy + 1) * 3 + std::size_t(dz + 1);
                     const openvdb::Coord o = leaf.origin().offsetBy(8 * dx, 8 * dy, 8 * dz);
                     const Leaf* n = grid.tree().probeConstLeaf(o);
                     a.buffer[k] = n ? n->buffer().data() : nullptr;
@@ -52,10 +55,10 @@ struct PaddedLeaf {
                 const int ny = y < 0 ? 0 : y > 7 ? 2 : 1, ly = (y + 8) & 7;
                 for (int z = -1; z <= 8; ++z) {
                     const int nz = z < 0 ? 0 : z > 7 ? 2 : 1, lz = (z + 8) & 7;
-                    const std::size_t k = std::size_t(nx * 9 + ny * 3 + nz);
+                    const std::size_t k =
+                        std::size_t(nx) * 9 + std::size_t(ny) * 3 + std::size_t(nz);
                     const float* b = a.buffer[k];
-                    v[std::size_t((x + 1) * 100 + (y + 1) * 10 + z + 1)] =
-                        b ? b[lx * 64 + ly * 8 + lz] : a.value[k];
+                    v[index(x, y, z)] = b ? b[lx * 64 + ly * 8 + lz] : a.value[k];
                 }
             }
         }
