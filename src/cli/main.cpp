@@ -32,6 +32,7 @@
 #include "io/vdb_file.h"
 #include "levelset/create.h"
 #include "levelset/measure.h"
+#include "levelset/peer_check.h"
 #include "mesh/marching_cubes.h"
 #include "sculpt/film.h"
 #include "sculpt/sculptor.h"
@@ -213,6 +214,7 @@ int runInfo(const std::string& path, const std::string& gridName) {
     // LevelSetMeasure's smeared integrals drift by a few tenths of a percent.
     const TriangleMesh mesh = meshLevelSet(*grid);
     const double meshVolume = enclosedVolume(mesh);
+    const PeerCheck peer = peerCheck(*grid);
     if (gOut.json) {
         json j = infoJson(m);
         j["file"] = path;
@@ -220,6 +222,13 @@ int runInfo(const std::string& path, const std::string& gridName) {
         j["grids_in_file"] = file.grids;
         j["mesh_volume"] = meshVolume;
         j["mesh_triangles"] = mesh.triangles.size();
+        j["openvdb_check"] = peer.message;
+        j["eikonal_outliers"] = peer.eikonal;
+        j["eikonal_outliers_on_thin_features"] = peer.eikonalThin;
+        j["thin_feature_voxels"] = peer.thinVoxels;
+        j["thin_feature_bbox"] = peer.thinBox.empty()
+                                     ? json(nullptr)
+                                     : json{vec(peer.thinBox.min), vec(peer.thinBox.max)};
         std::cout << j.dump(2) << "\n";
         return 0;
     }
@@ -244,6 +253,18 @@ int runInfo(const std::string& path, const std::string& gridName) {
                 m.components);
     std::printf("  marching-cubes surface: %zu triangles, enclosed volume %.6g\n",
                 mesh.triangles.size(), meshVolume);
+    std::printf("  OpenVDB's checkLevelSet: %s\n",
+                peer.message.empty() ? "no complaint" : peer.message.c_str());
+    if (peer.eikonal > 0)
+        std::printf("    its gradient test refuses %zu of the %zu voxels next to the surface; %zu "
+                    "of them lie on features thinner than its stencil reads\n",
+                    peer.eikonal, peer.surfaceVoxels, peer.eikonalThin);
+    if (peer.thinVoxels > 0)
+        std::printf("  thin features (two surfaces, or a ridge of the distance, within 3 voxels): "
+                    "%zu voxels next to the surface, in [%g %g %g] - [%g %g %g]\n",
+                    peer.thinVoxels, peer.thinBox.min.x(), peer.thinBox.min.y(),
+                    peer.thinBox.min.z(), peer.thinBox.max.x(), peer.thinBox.max.y(),
+                    peer.thinBox.max.z());
     return 0;
 }
 

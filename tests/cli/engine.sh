@@ -84,7 +84,12 @@ assert info["components"] == 1, info
 sphere = 4 / 3 * 3.141592653589793
 assert 1.10 * sphere < info["volume"] < 1.25 * sphere, info["volume"]
 assert 2.2 < info["bbox"][1][1] < 2.6, info["bbox"]
+# OpenVDB's diagnostics, and how much of their gradient test thin features account for.
+assert isinstance(info["openvdb_check"], str), info
+assert 0 <= info["eikonal_outliers_on_thin_features"] <= info["eikonal_outliers"], info
+assert (info["thin_feature_bbox"] is None) == (info["thin_feature_voxels"] == 0), info
 PY
+"$cli" info "$tmp/horn.vdb" | grep -q "OpenVDB's checkLevelSet: " || fail "info: no word of checkLevelSet"
 "$cli" mesh "$tmp/horn.vdb" -o "$tmp/horn.obj" 2>/dev/null
 grep -q "^f " "$tmp/horn.obj" || fail "mesh wrote no faces"
 

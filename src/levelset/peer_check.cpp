@@ -1,0 +1,125 @@
+#include "levelset/peer_check.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+
+#include <openvdb/math/Stencils.h>
+#include <openvdb/tools/Diagnostics.h>
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tree/LeafManager.h>
+#include <tbb/parallel_reduce.h>
+
+namespace sweepers {
+
+namespace {
+
+// Along the normal (the central gradient) through c, sampled each voxel for three voxels
+// either way: the surface is crossed more than once (a sheet or a gap thinner than that),
+// or |phi| stops growing away from the surface on either side (a ridge of the distance,
+// the medial axis of a part thinner than that).
+// Or a crease: the normal turns by more than 40 degrees from c to a face neighbour.
+template <typename Sampler>
+bool onThinFeature(const Grid::ConstAccessor& acc, const Sampler& sample, const openvdb::Coord& c,
+                   float h) {
+    const auto v = [&](int dx, int dy, int dz) { return acc.getValue(c.offsetBy(dx, dy, dz)); };
+    const auto normal = [&](const openvdb::Coord& q) {
+        const auto u = [&](int dx, int dy, int dz) {
+            return double(acc.getValue(q.offsetBy(dx, dy, dz)));
+        };
+        return openvdb::Vec3d(u(1, 0, 0) - u(-1, 0, 0), u(0, 1, 0) - u(0, -1, 0),
+                              u(0, 0, 1) - u(0, 0, -1));
+    };
+    openvdb::Vec3d n = normal(c);
+    if (n.lengthSqr() < 1e-12 * h * h) return true; // no direction at all: a ridge
+    n.normalize();
+    const double cos40 = std::cos(40.0 * M_PI / 180.0);
+    for (int a = 0; a < 3; ++a)
+        for (const int d : {-1, 1}) {
+            openvdb::Coord q = c;
+            q[a] += d;
+            const openvdb::Vec3d m = normal(q);
+            if (m.lengthSqr() < 1e-12 * h * h || m.unit().dot(n) < cos40) return true;
+        }
+    float row[7];
+    const openvdb::Vec3d at = c.asVec3d();
+    for (int k = -3; k <= 3; ++k)
+        row[k + 3] = k == 0 ? v(0, 0, 0) : float(sample.isSample(at + double(k) * n));
+    int crossings = 0;
+    for (int k = 0; k < 6; ++k)
+        crossings += (row[k] < 0.0f) != (row[k + 1] < 0.0f);
+    if (crossings > 1) return true;
+    // From the crossing outward on each side, |phi| grows (a tenth of a voxel of slack).
+    int cross = 0;
+    while (cross < 6 && (row[cross] < 0.0f) == (row[cross + 1] < 0.0f))
+        ++cross;
+    if (cross == 6) return false; // the normal misses the surface within reach
+    for (int k = cross + 1; k < 6; ++k)
+        if (std::abs(row[k + 1]) < std::abs(row[k]) - 0.1f * h) return true;
+    for (int k = cross; k > 0; --k)
+        if (std::abs(row[k - 1]) < std::abs(row[k]) - 0.1f * h) return true;
+    return false;
+}
+
+struct Counts {
+    std::size_t eikonal = 0, eikonalThin = 0, surface = 0, thin = 0;
+    openvdb::CoordBBox thinBox;
+};
+
+} // namespace
+
+PeerCheck peerCheck(const Grid& grid) {
+    PeerCheck r;
+    openvdb::tools::CheckLevelSet<Grid> check(grid);
+    r.message = check.check(/*n=*/9, /*updateMask=*/false);
+    while (!r.message.empty() && std::isspace(static_cast<unsigned char>(r.message.back())))
+        r.message.pop_back();
+    if (!grid.hasUniformVoxels()) return r;
+    const float h = float(grid.voxelSize()[0]);
+    openvdb::tree::LeafManager<const Grid::TreeType> leaves(grid.tree());
+    const Counts c = tbb::parallel_reduce(
+        leaves.leafRange(), Counts(),
+        [&](const auto& range, Counts acc) {
+            openvdb::math::WenoStencil<Grid> stencil(grid);
+            const Grid::ConstAccessor values = grid.getConstAccessor();
+            const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler>
+                sample(values, grid.transform());
+            for (auto leaf = range.begin(); leaf; ++leaf)
+                for (auto it = leaf->cbeginValueOn(); it; ++it) {
+                    stencil.moveTo(it.getCoord());
+                    if (!stencil.zeroCrossing()) continue; // as CheckEikonal
+                    ++acc.surface;
+                    const bool thin = onThinFeature(values, sample, it.getCoord(), h);
+                    if (thin) {
+                        ++acc.thin;
+                        acc.thinBox.expand(it.getCoord());
+                    }
+                    const float g2 = stencil.normSqGrad();
+                    if (g2 < 0.5f || g2 > 1.5f) {
+                        ++acc.eikonal;
+                        acc.eikonalThin += thin;
+                    }
+                }
+            return acc;
+        },
+        [](Counts a, const Counts& b) {
+            a.eikonal += b.eikonal;
+            a.eikonalThin += b.eikonalThin;
+            a.surface += b.surface;
+            a.thin += b.thin;
+            a.thinBox.expand(b.thinBox);
+            return a;
+        });
+    r.eikonal = c.eikonal;
+    r.eikonalThin = c.eikonalThin;
+    r.surfaceVoxels = c.surface;
+    r.thinVoxels = c.thin;
+    if (c.thin > 0) {
+        const openvdb::Vec3d lo = grid.indexToWorld(c.thinBox.min()),
+                             hi = grid.indexToWorld(c.thinBox.max());
+        r.thinBox = Box(toEigen(lo), toEigen(hi));
+    }
+    return r;
+}
+
+} // namespace sweepers

@@ -1,0 +1,38 @@
+// What OpenVDB's own diagnostics (tools::checkLevelSet, which Houdini's VDB Diagnostics and
+// vdb_tool apply too) say of a level set, and how much of their eikonal complaint sits on
+// features thinner than their stencil reads.
+//
+// The eikonal test takes |grad phi|^2 by fifth-order WENO, upwind (Godunov), at every voxel
+// with a face neighbour across the surface, and refuses it outside [0.5, 1.5]. Its stencil
+// reads three voxels each way along each axis. Where the shape is thinner than that, a
+// distance field itself has a ridge (the shape's medial axis) or a second surface inside the
+// stencil, the one-sided differences read across it, and even the exact distance fails.
+// Such a voxel is on a thin feature when, along the normal through it, within three voxels
+// either way, the surface is crossed twice (a sheet or a gap thinner than that) or |phi|
+// stops growing away from the surface (a ridge of the distance: the medial axis of a part
+// thinner than that), or where the surface creases: the normal (the central gradient)
+// turns by more than 40 degrees from the voxel to a face neighbour, as at a box's edge,
+// where the medial axis meets the surface.
+#pragma once
+
+#include <cstddef>
+#include <string>
+
+#include "core/box.h"
+#include "levelset/vdb.h"
+
+namespace sweepers {
+
+struct PeerCheck {
+    std::string message;           // checkLevelSet's first complaint (all nine tests); empty: none
+    std::size_t eikonal = 0;       // voxels next to the surface the eikonal test refuses
+    std::size_t eikonalThin = 0;   // ... of which on thin features
+    std::size_t surfaceVoxels = 0; // voxels next to the surface (those the test reads)
+    std::size_t thinVoxels = 0;    // ... of which on thin features
+    Box thinBox;                   // world box of those, empty when none
+};
+
+// Runs OpenVDB's checks and classifies the eikonal test's voxels.
+PeerCheck peerCheck(const Grid& grid);
+
+} // namespace sweepers
