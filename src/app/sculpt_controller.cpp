@@ -550,6 +550,7 @@ void SculptController::step() {
                 sw.move = p.t - last_.t;
                 sw.radius = settings_.radius;
                 sw.strength = settings_.strength;
+                sw.radial = radial();
                 launch([doc, sw] { return doc->applyStroke(sw); });
             } else if (mode_ == SculptMode::Fluid) {
                 // The ball pushes the clay as through a fluid from the last position to this
@@ -558,6 +559,7 @@ void SculptController::step() {
                 FluidStroke fl;
                 fl.radius = settings_.radius;
                 fl.path = {last_.t, p.t};
+                fl.strength = settings_.strength;
                 launch([doc, fl]() mutable {
                     fl.fluid = sweptFluid();
                     return doc->applyStroke(fl);

@@ -57,12 +57,12 @@ struct ToolSettings {
     SculptMode mode = SculptMode::Grab;
     MirrorAxis mirror = MirrorAxis::None;
     double radius = 0.25, falloff = 0.25;
-    // (0, 1]: the fraction of the hand's motion a grab, twist or inflate applies, of a
-    // swirl's move, of the clay ball's radius, of a smooth dab's flow time.
+    // (0, 1]: the fraction of the hand's motion a grab, twist, inflate or fluid applies, of
+    // a swirl's move, of the clay ball's radius, of a smooth dab's flow time.
     double strength = 1.0;
     // Radial symmetry: `radialCount` copies of a grab, twist or inflate tool (and of each
-    // dab of clay or smoothing) turned about the axis `radialAxis` (0 x, 1 y, 2 z) through
-    // the origin; 1 is the tool alone.
+    // swirl ring and dab of clay or smoothing) turned about the axis `radialAxis` (0 x, 1 y,
+    // 2 z) through the origin; 1 is the tool alone.
     int radialCount = 1, radialAxis = 1;
     bool wireframe = false;
     // Grab and twist move this shape instead of a ball when set (a baked tool, 3.4.3),

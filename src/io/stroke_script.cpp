@@ -55,7 +55,7 @@ const std::pair<const char*, std::vector<const char*>> kScriptFields[] = {
     {"rotation field", {"rotation"}},
     {"rotation", {"center", "axis", "degrees_per_second", "radius", "falloff"}},
     {"file field", {"vdb", "grid"}},
-    {"fluid", {"type", "radius", "path"}},
+    {"fluid", {"type", "radius", "path", "strength"}},
 };
 
 const std::vector<const char*>& fieldsOf(std::string_view object) {
@@ -369,6 +369,7 @@ SlideStroke readSlide(const Reader& r, const json& v, const std::string& at) {
 FluidStroke readFluid(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "fluid");
     FluidStroke s;
+    s.strength = readStrength(r, v, at);
     s.radius = r.positive(r.require(v, at, "radius"), at + "/radius");
     const json& path = r.require(v, at, "path");
     if (!path.is_array() || path.size() < 2)
@@ -878,6 +879,7 @@ std::string formatStrokeScript(const StrokeScript& s, int indent) {
             j["path"] = json::array();
             for (const Eigen::Vector3d& p : fluid->path)
                 j["path"].push_back(vecJson(p));
+            if (fluid->strength != 1.0) j["strength"] = fluid->strength;
         } else if (const auto* flow = std::get_if<FlowStroke>(&stroke)) {
             j["type"] = "flow";
             const FieldSpec& f = flow->field;

@@ -26,9 +26,11 @@ std::size_t pathSegments(const Stroke& stroke) {
 // another stroke, or where those placements are not of the form T R S.
 std::unique_ptr<StepDeformation> sweptPart(const Stroke& stroke, std::size_t k, double f) {
     // A fluid tool partway: the same tool moved that fraction of its segment.
-    if (const auto* fluid = std::get_if<FluidStroke>(&stroke); fluid && fluid->fluid)
-        return sweptFluidSegment(*fluid->fluid, fluid->radius, fluid->path[k],
-                                 fluid->path[k] + f * (fluid->path[k + 1] - fluid->path[k]));
+    if (const auto* fluid = std::get_if<FluidStroke>(&stroke); fluid && fluid->fluid) {
+        const std::vector<Eigen::Vector3d> path = fluid->ballPath();
+        return sweptFluidSegment(*fluid->fluid, fluid->radius, path[k],
+                                 path[k] + f * (path[k + 1] - path[k]));
+    }
     const auto* stroked = std::get_if<SweepStroke>(&stroke);
     if (!stroked) return nullptr;
     Sweep sweep = toSweep(*stroked);

@@ -20,6 +20,13 @@ Eigen::Affine3d RadialSymmetry::turn(int k) const {
            Eigen::Translation3d(-center);
 }
 
+std::vector<Eigen::Vector3d> FluidStroke::ballPath() const {
+    std::vector<Eigen::Vector3d> out = path;
+    for (Eigen::Vector3d& p : out)
+        p = path.front() + strength * (p - path.front());
+    return out;
+}
+
 Sweep toSweep(const SweepStroke& stroke) {
     Sweep sweep;
     sweep.mirror = stroke.mirror;
@@ -198,9 +205,9 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
             },
             [&](const FluidStroke& s) {
                 if (!s.fluid) throw std::invalid_argument("the swept fluid was not solved");
-                for (std::size_t k = 0; k + 1 < s.path.size(); ++k)
-                    parts.push_back(
-                        sweptFluidSegment(*s.fluid, s.radius, s.path[k], s.path[k + 1]));
+                const std::vector<Eigen::Vector3d> path = s.ballPath();
+                for (std::size_t k = 0; k + 1 < path.size(); ++k)
+                    parts.push_back(sweptFluidSegment(*s.fluid, s.radius, path[k], path[k + 1]));
             },
             [&](const SmoothStroke&) {},
         },

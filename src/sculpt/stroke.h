@@ -151,9 +151,14 @@ struct FlowStroke {
 
 // A ball of `radius` moved along `path` through the shape as through an incompressible fluid
 // (deform/swept_fluid.h): one resample a path segment, each the steps of 4.26 chained.
+// strength: the ball goes that fraction of the way along the path, each point taken that
+// fraction of the way from the first (the hand's path, drawn in toward where it began).
 struct FluidStroke {
     double radius = 0.3;
     std::vector<Eigen::Vector3d> path; // two points or more, no two successive ones equal
+    double strength = 1.0;
+    // The path the ball follows: p_0 + strength (p_k - p_0).
+    std::vector<Eigen::Vector3d> ballPath() const;
     // The solution it sweeps, found by io/ (io/fluid_cache.h) when the script is read.
     std::shared_ptr<const SweptFluid> fluid;
 };

@@ -187,12 +187,14 @@ def test_a_sculptor_starts_from_a_vdb_or_a_mesh(twisted):
 
 
 def grab(strength=None, stroke="sweep"):
-    """A unit sphere at 1/32 with the top grabbed 0.4 up (or a swirl or an inflation there)."""
+    """A unit sphere at 1/32 with the top grabbed 0.4 up (or a swirl, an inflation or a fluid
+    push there)."""
     strokes = {
         "sweep": {"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3,
                                              "path": [{"t": [0, 1, 0]}, {"t": [0, 1.4, 0]}]}]},
         "swirl": {"type": "swirl", "at": [0, 0.9, 0], "move": [0, 0.4, 0], "radius": 0.3},
         "inflate": {"type": "inflate", "at": [0, 0.9, 0], "radius": 0.3},
+        "fluid": {"type": "fluid", "radius": 0.3, "path": [[0, 0.85, 0], [0, 1.25, 0]]},
     }
     stroke = dict(strokes[stroke])
     if strength is not None:
@@ -219,8 +221,8 @@ def test_a_grab_of_strength_half_moves_the_surface_half_as_far():
     assert abs(moved_half - moved_full / 2) < 1 / 32  # within a voxel
     # Strength 1 is the stroke as it was, voxel for voxel.
     assert voxels(grab(1.0).to_pyopenvdb()) == voxels(full.to_pyopenvdb())
-    # A swirl's move and an inflation's radius take it too.
-    for kind in ("swirl", "inflate"):
+    # A swirl's move, an inflation's radius and a fluid push take it too.
+    for kind in ("swirl", "inflate", "fluid"):
         assert top(grab(0.5, kind)) - top(start) < 0.8 * (top(grab(None, kind)) - top(start))
 
 

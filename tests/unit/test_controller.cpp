@@ -623,4 +623,20 @@ TEST(SculptController, RadialCopiesOfAGrabAreSymmetric) {
     std::printf("[ radial ] 5 copies: %.4f voxel RMS between the surface and itself turned\n", rms);
     EXPECT_LT(rms, 0.05);
     EXPECT_EQ(s.ctl.symmetryPreview(glm::dvec3(0.5, 0.2, 0.3)).size(), 4u * 2 * 48);
+    // Swirls, clay and smoothing record the symmetry as theirs.
+    for (const int key : {'S', 'C', 'O'}) {
+        s.ctl.onKey(key, false, false);
+        dragOn(s.ctl, x, y, x + 20, y - 20, 2);
+        const Stroke& last = s.doc.script().strokes.back();
+        const int count = std::visit(
+            [](const auto& st) {
+                if constexpr (std::is_same_v<std::decay_t<decltype(st)>, SwirlStroke> ||
+                              std::is_same_v<std::decay_t<decltype(st)>, InflateStroke> ||
+                              std::is_same_v<std::decay_t<decltype(st)>, SmoothStroke>)
+                    return st.radial.count;
+                return 0;
+            },
+            last);
+        EXPECT_EQ(count, 5) << char(key);
+    }
 }
