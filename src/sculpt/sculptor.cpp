@@ -59,9 +59,10 @@ SegmentReport Sculptor::applySmoothDab(const SmoothBrush& brush) {
     CurvatureSmoother smoother(*grid_, brush, options_.interrupter);
     if (recording_) record_.capture(*grid_, smoother.reach());
     SegmentReport r;
-    const auto t0 = Clock::now();
+    const SerialClock dab;
     const SmoothStats s = smoother.run();
-    r.seconds = secondsSince(t0);
+    r.seconds = r.otherSeconds = dab.wallSeconds();
+    r.otherSerialSeconds = dab.serialSeconds();
     if (meshing_) {
         const SerialClock clock;
         r.remeshedLeaves = mesher_.update(*grid_, s.changed);

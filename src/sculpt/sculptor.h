@@ -31,10 +31,13 @@ struct SegmentReport {
     // AdvectStats times.
     double advectSeconds() const { return seconds - stats.renormalizeSeconds; }
     double meshSerialSeconds = 0.0; // of the re-meshing, on one thread while others waited
+    // Work outside the advection's phases that kept its own serial clock (a smooth dab):
+    // its wall time, and its time on one thread while the others waited.
+    double otherSeconds = 0.0, otherSerialSeconds = 0.0;
     // The segment's serial time (levelset/parallel.h): each phase's, what runs around the
     // phases on one thread, and the re-meshing's.
     double serialSeconds() const {
-        double phases = 0.0, serial = meshSerialSeconds;
+        double phases = otherSeconds, serial = meshSerialSeconds + otherSerialSeconds;
         for (const AdvectStats::PhaseTime& p : stats.phases) {
             phases += p.seconds;
             serial += p.serialSeconds;
