@@ -132,7 +132,8 @@ void CurvatureSmoother::collectLeaves() {
 void CurvatureSmoother::weigh() {
     const double r = brush_.radius, f = brush_.falloff;
     const float bg = grid_.background();
-    // Band voxels (not the +-background of those just taken in) within the falloff's reach.
+    // Band voxels within the falloff's reach (not those at +-background: they hold no
+    // distance).
     std::vector<std::array<float, Leaf::SIZE>> weight(leaves_.size());
     std::vector<char> reached(leaves_.size(), 0);
     parallelFor(tbb::blocked_range<std::size_t>(0, leaves_.size()), [&](const auto& range) {

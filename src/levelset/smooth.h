@@ -10,8 +10,8 @@
 // Written here rather than taken from OpenVDB's LevelSetFilter::meanCurvature because
 // that filter visits every leaf of the grid at each step (its mask only weights the
 // update) and renormalizes the whole band after it: a dab's cost would follow the model.
-// This one visits only the band voxels near the surface inside the brush's box, and
-// renormalizes that box.
+// This one visits only the band inside the brush's reach, and renormalizes the ball it
+// reaches.
 #pragma once
 
 #include <array>
