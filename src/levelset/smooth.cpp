@@ -120,12 +120,25 @@ SmoothStats CurvatureSmoother::run() {
 
 void CurvatureSmoother::collectLeaves() {
     leaves_.clear();
-    // Leaf by leaf origin inside the reach: the work is the brush's, not the grid's.
+    // Leaf by leaf origin inside the reach: the work is the brush's, not the grid's. A
+    // brush larger than the shape would probe mostly empty space: then the grid's own
+    // leaves are walked instead, so the work is the smaller of the two.
     const openvdb::Coord lo = reach_.min() & ~(Leaf::DIM - 1), hi = reach_.max();
-    for (int x = lo.x(); x <= hi.x(); x += Leaf::DIM)
-        for (int y = lo.y(); y <= hi.y(); y += Leaf::DIM)
-            for (int z = lo.z(); z <= hi.z(); z += Leaf::DIM)
-                if (Leaf* leaf = grid_.tree().probeLeaf({x, y, z})) leaves_.push_back(leaf);
+    const openvdb::Coord slots = ((hi - lo) >> Leaf::LOG2DIM) + openvdb::Coord(1);
+    const double probes = double(slots.x()) * slots.y() * slots.z();
+    if (probes > double(grid_.tree().leafCount())) {
+        for (auto it = grid_.tree().beginLeaf(); it; ++it) {
+            ++stats_.leavesVisited;
+            if (reach_.hasOverlap(it->getNodeBoundingBox())) leaves_.push_back(&*it);
+        }
+    } else {
+        for (int x = lo.x(); x <= hi.x(); x += Leaf::DIM)
+            for (int y = lo.y(); y <= hi.y(); y += Leaf::DIM)
+                for (int z = lo.z(); z <= hi.z(); z += Leaf::DIM) {
+                    ++stats_.leavesVisited;
+                    if (Leaf* leaf = grid_.tree().probeLeaf({x, y, z})) leaves_.push_back(leaf);
+                }
+    }
     stats_.leaves = leaves_.size();
 }
 

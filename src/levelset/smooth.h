@@ -33,10 +33,11 @@ struct SmoothBrush {
 };
 
 struct SmoothStats {
-    openvdb::CoordBBox changed; // index box of every voxel the dab may have changed
-    int steps = 0;              // explicit flow steps
-    std::size_t updates = 0;    // voxel updates, all steps together
-    std::size_t leaves = 0;     // leaves under the brush
+    openvdb::CoordBBox changed;    // index box of every voxel the dab may have changed
+    int steps = 0;                 // explicit flow steps
+    std::size_t updates = 0;       // voxel updates, all steps together
+    std::size_t leaves = 0;        // leaves under the brush
+    std::size_t leavesVisited = 0; // leaf places probed (or leaves walked) to find them
 };
 
 class CurvatureSmoother {

@@ -186,3 +186,23 @@ TEST(Smooth, ManyDabsKeepAValidNarrowBand) {
         EXPECT_EQ(topologicalEulerCharacteristic(sculptor.grid()), 2) << "pass " << pass;
     }
 }
+
+TEST(Smooth, ABrushLargerThanTheShapeVisitsNoMoreThanItsLeaves) {
+    // A ball of radius 40 around a sphere of 0.5 at 1/96: its reach box holds millions of
+    // leaf places, nearly all empty; finding the leaves under it walks the grid's instead.
+    const GridPtr g = bumpySphere();
+    SmoothBrush brush;
+    brush.center = Eigen::Vector3d(0.0, kR, 0.0);
+    brush.radius = 40.0;
+    brush.falloff = 0.1;
+    brush.time = 1e-5;
+    const std::size_t leaves = g->tree().leafCount();
+    const SmoothStats s = smoothLevelSet(*g, brush);
+    EXPECT_EQ(s.leaves, leaves);
+    EXPECT_LE(s.leavesVisited, leaves);
+    // A small brush probes its own box, fewer places than the grid has leaves.
+    brush.radius = 0.05;
+    const SmoothStats small = smoothLevelSet(*g, brush);
+    EXPECT_LT(small.leavesVisited, g->tree().leafCount());
+    EXPECT_GT(small.leaves, 0u);
+}
