@@ -15,8 +15,10 @@ cat >"$tmp/translate.json" <<'EOF'
 EOF
 "$cli" study "$tmp/translate.json" -o "$tmp/t" --voxel-sizes 1/32,1/64 \
   --variants trilinear,first-order -q
-"$py" - "$tmp/t" <<'PY'
-import csv, math, struct, sys
+"$py" - "$tmp/t" "$(dirname "$0")/.." <<'PY'
+import csv, math, sys
+sys.path.insert(0, sys.argv[2])
+from ply import read_ply
 d = sys.argv[1]
 rows = list(csv.DictReader(open(f"{d}/study.csv")))
 columns = ("script variant voxel_size wall_s advect_s renorm_s mesh_s peak_rss_mb active_voxels volume "
@@ -32,28 +34,12 @@ for r in rows:
     assert r["failure"] == "" and int(r["euler"]) == 2 and int(r["components"]) == 1, r
 # Independently: the distance of every vertex of the exported mesh to the moved sphere
 # (a binary PLY whose vertices are float properties, x y z first).
-data = open(f"{d}/runs/translate-trilinear_64/mesh.ply", "rb").read()
-header, body = data.split(b"end_header\n", 1)
-lines = header.decode().splitlines()
-start = next(i for i, l in enumerate(lines) if l.startswith("element vertex"))
-count = int(lines[start].split()[2])
-props = 0
-for l in lines[start + 1:]:
-    if not l.startswith("property"):
-        break
-    assert l.split()[1] == "float", l
-    props += 1
-face_line = next(l for l in lines if l.startswith("element face"))
-faces = int(face_line.split()[2])
-kinds = lines[lines.index(face_line) + 1].split()
-assert kinds[:3] == ["property", "list", "uchar"] and kinds[3] in ("int", "uint"), kinds
-err, points, moved = [], [], []
+points, triangles = read_ply(f"{d}/runs/translate-trilinear_64/mesh.ply")
+err, moved = [], []
 c, radius = (0.2, 0.1, 0.0), 0.5
-for i in range(count):
-    p = struct.unpack_from("<3f", body, i * 4 * props)
+for p in points:
     d = math.dist(p, c)
     err.append(d - radius)
-    points.append(p)
     moved.append(tuple(c[k] + radius * (p[k] - c[k]) / d for k in range(3)))
 independent = math.sqrt(sum(e * e for e in err) / len(err))
 study = float(rows[2]["err_rms"])
@@ -67,11 +53,6 @@ def volume(v, triangles):
         (ax, ay, az), (bx, by, bz), (tx, ty, tz) = v[a], v[b], v[t]
         total += ax * (by * tz - bz * ty) - ay * (bx * tz - bz * tx) + az * (bx * ty - by * tx)
     return total / 6.0
-at, triangles = count * 4 * props, []
-for _ in range(faces):
-    assert body[at] == 3, "not a triangle"
-    triangles.append(struct.unpack_from("<3i", body, at + 1))
-    at += 13
 mesh, exact = abs(volume(points, triangles)), abs(volume(moved, triangles))
 independent, study = mesh - exact, float(rows[2]["volume_err"])
 print(f"translated sphere at 1/64: study volume_err {study:.3g}, against the analytic sphere "

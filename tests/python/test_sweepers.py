@@ -7,8 +7,8 @@ import csv
 import json
 import os
 import signal
-import struct
 import subprocess
+import sys
 import threading
 import time
 
@@ -17,6 +17,9 @@ import pyopenvdb as vdb
 import pytest
 
 import sweepers
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+import ply  # noqa: E402 (the tests' own PLY reader, in tests/)
 
 CLI = os.environ["SWEEPERS_CLI"]
 DATA = os.environ["SWEEPERS_DATA"]
@@ -44,26 +47,9 @@ def voxels(grid):
 
 
 def read_ply(path):
-    """The vertices and triangles of a binary little-endian PLY of float x y z (and more
-    float properties) and uchar-counted int faces, as the CLI writes it."""
-    data = open(path, "rb").read()
-    header, body = data.split(b"end_header\n", 1)
-    lines = header.decode().splitlines()
-    start = next(i for i, l in enumerate(lines) if l.startswith("element vertex"))
-    count = int(lines[start].split()[2])
-    props = 0
-    for l in lines[start + 1:]:
-        if not l.startswith("property"):
-            break
-        props += 1
-    faces = int(next(l for l in lines if l.startswith("element face")).split()[2])
-    v = np.frombuffer(body, dtype="<f4", count=count * props).reshape(count, props)[:, :3]
-    at, tris = count * props * 4, []
-    for _ in range(faces):
-        assert body[at] == 3
-        tris.append(struct.unpack_from("<3i", body, at + 1))
-        at += 13
-    return v, np.array(tris, dtype=np.int32)
+    """The vertices (float32, n x 3) and triangles (int32) of a PLY the CLI wrote."""
+    vertices, triangles = ply.read_ply(path)
+    return np.array(vertices, dtype=np.float32), np.array(triangles, dtype=np.int32)
 
 
 @pytest.fixture(scope="module")
