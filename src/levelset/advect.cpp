@@ -1063,13 +1063,17 @@ void SegmentAdvector::Work::fixSigns() {
 // Renormalizes only where values changed, and as far as the band reaches from there (the
 // nearest surface of a voxel nearby may have moved): where the deformation is the identity
 // (outside the tools' coatings, which fill only part of the box) the distances hold. The
-// voxels the band grew into are freed too.
+// voxels the band grew into are freed too. Seeds are recomputed only next to what changed:
+// the others are distances already, and seeding them again at every segment would let the
+// surface creep where it curves within a voxel.
 void SegmentAdvector::Work::renormalizeChanged() {
     if (!options->renormalize) return;
     freed = dilatedByCube(changed, int(std::ceil(halfWidth)) + 1);
     freed.insert(freed.end(), fresh.begin(), fresh.end());
+    VoxelList moved = changed;
+    moved.insert(moved.end(), fresh.begin(), fresh.end());
     const FmmStats fmm =
-        renormalize(*grid, touched, freed, options->renormalization, options->interrupter);
+        renormalize(*grid, touched, freed, moved, options->renormalization, options->interrupter);
     stats.leavesVisited += fmm.leaves;
     stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
 }

@@ -374,7 +374,7 @@ constexpr int kMostSweeps = 32, kMostRounds = 100;
 class Renormalizer {
   public:
     Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
-                 FmmOrder order, Interrupter* interrupter)
+                 const VoxelList* moved, FmmOrder order, Interrupter* interrupter)
         : b_(grid, region, 2, only), n_(b_.size()), h_(float(grid.voxelSize()[0])),
           bg_(grid.background()), order_(order), interrupter_(interrupter),
           phi_(b_.leafCount(), nullptr), dist_(new float[n_]), thin_(b_.leafCount(), Bits{}),
@@ -432,6 +432,7 @@ class Renormalizer {
             });
             settled_[l] = fixed_[l];
         });
+        if (moved) findStencilsMoved(*moved);
     }
 
     // How leaf l's block is laid out and swept (bits 0-1: the leaf axis along its rows; bits
@@ -584,10 +585,11 @@ class Renormalizer {
             float d;
             if (!central || thin(i)) {
                 // On or next to a feature about one voxel thin (the surface on both sides along
-                // an axis) no gradient estimate is trustworthy, so the value is kept:
-                // recomputing it would move its crossings a little every time and let the
-                // feature drift.
-                d = std::min(std::abs(p), h);
+                // an axis) no gradient estimate is trustworthy, so the value is kept (recomputing
+                // it would move its crossings a little every time and let the feature drift),
+                // but capped by the distance to its nearest axis crossing, as every seed is: a
+                // value sampled from a stretched field may exceed it, and no distance does.
+                d = std::min(std::abs(p), nearestCrossing * h);
             } else if (grad2 > 1e-12 * double(h) * h) {
                 const double gradNorm = std::sqrt(grad2) / h;
                 // A value whose gradient is already unit within kUnitSlack is a distance: kept,
@@ -607,6 +609,14 @@ class Renormalizer {
             Bits candidates = acrossSurface(l, false);
             for (int x = 0; x < 8; ++x)
                 candidates[x] &= ~settled_[l][x] & ~beyond_[l][x];
+            if (!stencilMoved_.empty()) {
+                // A seed none of whose stencil moved keeps its value: a boundary value, as
+                // the fixed voxels are.
+                for (int x = 0; x < 8; ++x) {
+                    settled_[l][x] |= candidates[x] & ~stencilMoved_[l][x];
+                    candidates[x] &= stencilMoved_[l][x];
+                }
+            }
             std::size_t n = 0;
             forEachBit(candidates, [&](int off) {
                 if (!seedOne((l << 9) + std::size_t(off))) return;
@@ -616,6 +626,28 @@ class Renormalizer {
             count.local() += n;
         });
         return count.combine(std::plus<>());
+    }
+
+    // The voxels whose seed reads a value that moved: those in `moved` and their face
+    // neighbours. Recomputing a seed is not idempotent where the surface curves within a
+    // voxel: across a valley, central differences read a gradient below 1 even from a
+    // distance, phi / |grad phi| grows, and the crossing creeps towards the other side a few
+    // hundredths of a voxel at each renormalization. A segment renormalizes the band around
+    // what it changed, so without this the voxels near a tool's edge, which no deformation
+    // moves, were seeded again at every segment of a stroke (drag.json's valley crept 0.07
+    // voxel in seven segments).
+    void findStencilsMoved(const VoxelList& moved) {
+        std::vector<Bits> movedOf(b_.leafCount());
+        for (const LeafVoxels& leaf : moved)
+            if (const int l = b_.indexOf(leaf.origin); l >= 0)
+                leafwords::unite(movedOf[std::size_t(l)], leaf.words);
+        stencilMoved_.resize(b_.leafCount());
+        parallelFor(std::size_t(0), b_.leafCount(), [&](std::size_t l) {
+            stencilMoved_[l] =
+                movedOf[l] | nextTo(false, [&](auto a, int dir, Bits& out, Bits& valid) {
+                    b_.stepped<decltype(a)::value>(movedOf.data(), l, dir, out, valid);
+                });
+        });
     }
 
     // Which of two classes leaf l belongs to, by the parity of the sum of its position (a
@@ -1022,6 +1054,9 @@ class Renormalizer {
     // Per leaf: the inactive voxels next to free ones, free so that the band can grow into
     // them.
     std::unique_ptr<Bits[]> beyond_;
+    // Per leaf: the voxels whose seed inputs moved (findStencilsMoved); empty when every seed
+    // is recomputed.
+    std::vector<Bits> stencilMoved_;
     // Per leaf: how its block is laid out and swept (layoutOf).
     std::vector<std::uint8_t> layout_;
     // Per leaf: whether the write-back left it without an active voxel.
@@ -1029,10 +1064,10 @@ class Renormalizer {
 };
 
 FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
-                          FmmOrder order, Interrupter* interrupter) {
+                          const VoxelList* moved, FmmOrder order, Interrupter* interrupter) {
     if (region.empty()) return {};
     pollInterrupt(interrupter);
-    Renormalizer renormalizer(grid, region, only, order, interrupter);
+    Renormalizer renormalizer(grid, region, only, moved, order, interrupter);
     return renormalizer.run(grid);
 }
 
@@ -1040,12 +1075,17 @@ FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region, const Vo
 
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, FmmOrder order,
                      Interrupter* interrupter) {
-    return renormalizeWhere(grid, region, nullptr, order, interrupter);
+    return renormalizeWhere(grid, region, nullptr, nullptr, order, interrupter);
 }
 
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      FmmOrder order, Interrupter* interrupter) {
-    return renormalizeWhere(grid, region, &only, order, interrupter);
+    return renormalizeWhere(grid, region, &only, nullptr, order, interrupter);
+}
+
+FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
+                     const VoxelList& moved, FmmOrder order, Interrupter* interrupter) {
+    return renormalizeWhere(grid, region, &only, &moved, order, interrupter);
 }
 
 FmmStats renormalizeAll(Grid& grid, FmmOrder order, Interrupter* interrupter) {

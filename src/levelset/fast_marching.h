@@ -5,8 +5,10 @@
 //  1. seeds: every voxel with a face neighbour of the other sign gets phi / |grad phi|
 //     (central differences), capped by the distance to its nearest axis crossing. Values
 //     whose gradient is already unit within 1%, and values on or within two voxels of a
-//     feature one voxel thin, are kept: renormalizing twice changes nothing, and thin
-//     features do not drift. The sign of every voxel is kept.
+//     feature one voxel thin (but for that cap), are kept, and so are seeds whose stencil a
+//     deformation did not change (the `moved` overload): the estimate is not idempotent where
+//     the surface curves within a voxel, and an interface seeded again and again would creep.
+//     The sign of every voxel is kept.
 //  2. every other voxel gets the upwind solution from its neighbours of its own side: the
 //     first-order stencil, or the second-order one (HAFMM) where the voxel beyond the upwind
 //     neighbour is closer still. These are solved leaf by leaf, the leaves of one parity
@@ -52,6 +54,12 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region,
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
 
+// The same, where only the voxels of `moved` changed since the band was last a distance:
+// seeds are recomputed only where their stencil (the voxel and its face neighbours) holds a
+// voxel of `moved`; other seeds keep their values, as boundary.
+FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
+                     const VoxelList& moved, FmmOrder order = FmmOrder::Second,
+                     Interrupter* interrupter = nullptr);
 // Renormalizes the whole active band.
 FmmStats renormalizeAll(Grid& grid, FmmOrder order = FmmOrder::Second,
                         Interrupter* interrupter = nullptr);
