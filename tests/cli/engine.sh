@@ -46,6 +46,16 @@ PY
 done
 echo "background: at least the half-width at voxel sizes 0.02, 0.07, 0.011, half-widths 3 and 5"
 
+# --- `new` writes spheres OpenVDB's checkLevelSet accepts (all nine tests) ----------------
+for hw in 3 5; do
+  for h in 0.02 0.07 0.011; do
+    "$cli" new -o "$tmp/new.vdb" --voxel-size "$h" --half-width "$hw" --radius 0.6 -q
+    check=$("$cli" info --json "$tmp/new.vdb" | "$py" -c 'import json, sys; print(json.load(sys.stdin)["openvdb_check"])')
+    [ -z "$check" ] || fail "new at voxel size $h, half-width $hw: checkLevelSet says: $check"
+  done
+done
+echo "new: checkLevelSet accepts its spheres at voxel sizes 0.02, 0.07, 0.011, half-widths 3 and 5"
+
 # --- apply a real script, export a mesh, check the numbers --------------------------
 "$cli" apply "$data/horn.json" -o "$tmp/horn.vdb" --voxel-size 0.03125 --mesh "$tmp/horn.stl" 2>"$tmp/log"
 grep -q "volume" "$tmp/log" || fail "apply printed no volume"

@@ -15,6 +15,7 @@
 #include "io/stroke_script.h"
 #include "levelset/band.h"
 #include "levelset/measure.h"
+#include "levelset/peer_check.h"
 #include "mesh/marching_cubes.h"
 #include "meshes.h"
 #include "replay.h"
@@ -65,6 +66,29 @@ const std::map<std::string, std::vector<std::pair<int, std::size_t>>> kTopology 
     {"severed_horn", {{2, 1}, {4, 2}}},   // a pulled horn, then cut off
 };
 
+// What OpenVDB's checkLevelSet (all nine tests) refuses in a script's result: the voxels
+// its eikonal test refuses and the info report does not put on a feature the grid does not
+// resolve (thin parts, gaps, creases: levelset/peer_check.h), at most as many as measured
+// when this test was written (none is the goal): at the scripts' voxel sizes, and at the
+// coarse variant's twice them. Any other complaint fails.
+struct Unexplained {
+    std::size_t fine, coarse;
+};
+const std::map<std::string, Unexplained> kUnexplained = {
+    {"drag", {9, 47}},
+    {"finger", {0, 24}},
+    {"horn", {0, 6}},
+    {"mirrored_ears", {0, 18}},
+    {"pinch", {16, 25}},
+    {"pinch_torus", {920, 480}},
+    {"pull", {16, 8}},
+    {"severed_horn", {284, 148}},
+    {"starfish_swirls", {8, 4}},
+    {"strangle_torus", {2364, 904}},
+    {"twisted_limb", {2, 6}},
+    {"two_handles", {1640, 1828}},
+};
+
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
     const std::string name = GetParam();
     const StrokeScript script = readStrokeScript(dataPath(name));
@@ -89,6 +113,28 @@ TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
                     "%.2f%% of %zu interface voxels, %zu holes\n",
                     name.c_str(), 1.0 / h, stroke, r.activeVoxels, 100 * r.unitGradientFraction(),
                     r.nearInterface, r.bandHoles);
+    });
+}
+
+// OpenVDB's checkLevelSet on each script's result (kUnexplained).
+TEST_P(DataScript, OpenVdbsCheckRefusesNoMoreThanKnown) {
+    const std::string name = GetParam();
+    const StrokeScript script = readStrokeScript(dataPath(name));
+    const double h = voxelSize(script.grid.voxelSize);
+    applyScript(script, SWEEPERS_DATA_DIR, h, [&](std::size_t stroke, const Grid& g) {
+        if (stroke + 1 < script.strokes.size()) return;
+        const PeerCheck peer = peerCheck(g);
+        const std::size_t unexplained = peer.eikonal - peer.eikonalThin;
+        std::printf("[ peer ] %s at 1/%g: checkLevelSet refuses %zu of %zu voxels next to "
+                    "the surface, %zu of them on features the grid does not resolve\n",
+                    name.c_str(), 1.0 / h, peer.eikonal, peer.surfaceVoxels, peer.eikonalThin);
+        if (peer.eikonal == 0)
+            EXPECT_EQ(peer.message, "") << name;
+        else
+            EXPECT_NE(peer.message.find("outside the range of NormGrad"), std::string::npos)
+                << name << ": " << peer.message;
+        const Unexplained& most = kUnexplained.at(name);
+        EXPECT_LE(unexplained, coarse() ? most.coarse : most.fine) << name;
     });
 }
 
