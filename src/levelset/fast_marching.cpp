@@ -634,8 +634,7 @@ class Renormalizer {
     // distance, phi / |grad phi| grows, and the crossing creeps towards the other side a few
     // hundredths of a voxel at each renormalization. A segment renormalizes the band around
     // what it changed, so without this the voxels near a tool's edge, which no deformation
-    // moves, were seeded again at every segment of a stroke (drag.json's valley crept 0.07
-    // voxel in seven segments).
+    // moves, were seeded again at every segment of a stroke.
     void findStencilsMoved(const VoxelList& moved) {
         std::vector<Bits> movedOf(b_.leafCount());
         for (const LeafVoxels& leaf : moved)
