@@ -30,6 +30,11 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr double kUnitSlack = 0.01;
+// How far (in voxels) a seed's second-order estimate may lie from its central one before it
+// replaces it. Below this the two differ by the order of the bias that reading the grid
+// linearly (trilinear sampling, marching cubes' edge crossings) puts on a curved surface,
+// and the central value, whose own bias partly cancels it, places the surface better.
+constexpr double kSecondOrderSlack = 0.05;
 
 using Leaf = Grid::TreeType::LeafNodeType;
 constexpr int kLeafVoxels = Leaf::SIZE; // 512, offset = x * 64 + y * 8 + z
@@ -597,6 +602,15 @@ class Renormalizer {
                 d = std::abs(gradNorm - 1.0) < kUnitSlack
                         ? std::abs(p)
                         : std::min(float(std::abs(p) / gradNorm), nearestCrossing * h);
+                // Where the field bends within the voxel (a stretch that varies across it: a
+                // fillet, a tool's edge, a tear's rim) the central differences straddle the bend
+                // and read too small a gradient, and the value errs high, by a good part of a
+                // voxel at times, even where the gradient passes for unit. The second-order
+                // value replaces it only downwards: where the model asks for more it is the
+                // model that straddles a rim, and raising such seeds moves the surface off.
+                if (const float d2 = std::min(secondOrderDistance(i), nearestCrossing * h);
+                    d - d2 > float(kSecondOrderSlack) * h)
+                    d = d2;
             } else {
                 d = float(h / std::sqrt(inv2)); // distance to the plane through the crossings
             }
@@ -626,6 +640,56 @@ class Renormalizer {
             count.local() += n;
         });
         return count.combine(std::plus<>());
+    }
+
+    // |s| h for the root s (in voxels) nearest the voxel of the quadratic model of phi along
+    // its normal, phi + g s + c s^2 / 2 = 0, with g = |grad phi| and c = n^T H n (n = grad
+    // phi / g) from central differences on the 3x3x3 block: a distance along the normal to
+    // second order, where phi / |grad phi| is one to first order. The first-order value where
+    // the block is incomplete, the model has no real root or it is flat.
+    float secondOrderDistance(std::size_t i) const {
+        const double p = phi(i);
+        double g[3], H[3][3];
+        bool complete = true;
+        const auto at = [&](std::size_t j) {
+            if (j == Domain::npos) {
+                complete = false;
+                return 0.0;
+            }
+            return double(phi(j));
+        };
+        std::size_t face[3][2]; // the face neighbours, -1 and +1 along each axis
+        forEachAxis([&](auto a) {
+            for (const int dir : {-1, 1})
+                face[a][dir > 0] = b_.neighbour(i, dir, a);
+            const double minus = at(face[a][0]), plus = at(face[a][1]);
+            g[a] = 0.5 * (plus - minus);
+            H[a][a] = plus - 2.0 * p + minus;
+        });
+        // The mixed second differences, from the neighbours of the faces along the other axes.
+        forEachAxis([&](auto b) {
+            constexpr int B = decltype(b)::value;
+            for (int a = 0; a < B; ++a) {
+                const auto corner = [&](int da, int db) {
+                    const std::size_t j = face[a][da > 0];
+                    return at(j == Domain::npos ? j : b_.neighbour(j, db, b));
+                };
+                H[a][B] = H[B][a] =
+                    0.25 * (corner(1, 1) - corner(1, -1) - corner(-1, 1) + corner(-1, -1));
+            }
+        });
+        const double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
+        if (!complete || g2 < 1e-24)
+            return float(std::abs(p) / std::sqrt(std::max(g2, 1e-24)) * h_);
+        double c = 0.0;
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < 3; ++b)
+                c += g[a] * H[a][b] * g[b];
+        c /= g2;
+        const double gn = std::sqrt(g2), disc = g2 - 2.0 * c * p;
+        // The root nearest 0, written so that it does not cancel as c goes to 0.
+        const double s = disc > 0.0 ? 2.0 * std::abs(p) / (gn + std::sqrt(disc)) : std::abs(p) / gn;
+        return float(s * h_);
     }
 
     // The voxels whose seed reads a value that moved: those in `moved` and their face

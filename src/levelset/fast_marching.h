@@ -3,7 +3,9 @@
 // equations of fast marching rebuild |grad phi| = 1 outward from the surface:
 //
 //  1. seeds: every voxel with a face neighbour of the other sign gets phi / |grad phi|
-//     (central differences), capped by the distance to its nearest axis crossing. Values
+//     (central differences), capped by the distance to its nearest axis crossing, or the
+//     root of the second-order model of phi along the normal where that lies more than a
+//     twentieth of a voxel lower (the field bends within the voxel). Values
 //     whose gradient is already unit within 1%, and values on or within two voxels of a
 //     feature one voxel thin (but for that cap), are kept, and so are seeds whose stencil a
 //     deformation did not change (the `moved` overload): the estimate is not idempotent where

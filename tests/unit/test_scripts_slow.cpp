@@ -75,18 +75,18 @@ struct Unexplained {
     std::size_t fine, coarse;
 };
 const std::map<std::string, Unexplained> kUnexplained = {
-    {"drag", {9, 47}},
-    {"finger", {0, 24}},
-    {"horn", {0, 6}},
-    {"mirrored_ears", {0, 18}},
-    {"pinch", {16, 25}},
-    {"pinch_torus", {920, 480}},
-    {"pull", {16, 8}},
-    {"severed_horn", {284, 148}},
-    {"starfish_swirls", {8, 4}},
-    {"strangle_torus", {2364, 904}},
-    {"twisted_limb", {2, 6}},
-    {"two_handles", {1640, 1828}},
+    {"drag", {4, 14}},
+    {"finger", {0, 26}},
+    {"horn", {0, 0}},
+    {"mirrored_ears", {0, 4}},
+    {"pinch", {0, 27}},
+    {"pinch_torus", {528, 304}},
+    {"pull", {0, 0}},
+    {"severed_horn", {264, 108}},
+    {"starfish_swirls", {0, 0}},
+    {"strangle_torus", {1150, 428}},
+    {"twisted_limb", {2, 2}},
+    {"two_handles", {1260, 1864}},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
