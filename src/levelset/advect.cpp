@@ -268,8 +268,8 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 
 // Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
 // the pre-image of x (`map(x, n, y, scratch)` maps a leaf's n voxels x at once, into y), and lists
-// in `changed` the voxels whose value changed, a leaf at a time (a leaf resampled again is listed
-// again). When the source holds the grid's own values
+// in `changes` the voxels whose value changed, and those that moved by more than a nudge, a leaf
+// at a time (a leaf resampled again is listed again). When the source holds the grid's own values
 // (`sourceIsGrid`: no widened band), a voxel that the map leaves in place keeps its value
 // without interpolating: a sample at a voxel centre returns it exactly. With `staged`, the
 // new values go there and the leaves keep theirs.
@@ -279,6 +279,15 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 // squeezes) keeps a membrane a few voxels thick where the exact surface meets itself at one
 // point (the grid rounds off the funnels' tips), and the tear opens through it instead of
 // keeping it as the rim of the hole.
+// What a sampling pass lists: every voxel whose value changed or that joined the band
+// (`changed`), and of them those whose value moved by more than `nudge` (world units) or that
+// joined (`moved`): the renormalization seeds again only next to those.
+struct Changes {
+    VoxelList& changed;
+    VoxelList& moved;
+    float nudge;
+};
+
 // Per thread, what sampling a leaf uses: the block of source values around it, and its
 // voxels to sample with their places and pre-images.
 struct ResampleScratch {
@@ -293,11 +302,11 @@ template <typename Map>
 std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const SampleSource& source,
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
                      const StepDeformation* tearing, double tornWindow, Sampling sampling,
-                     VoxelList& changed, Interrupter* interrupter, ResampleScratches& scratch,
+                     Changes changes, Interrupter* interrupter, ResampleScratches& scratch,
                      const openvdb::MaskTree* only = nullptr, Staged* staged = nullptr) {
-    // Per leaf, the voxels whose value changed (a word per x, as the leaf's mask holds them):
-    // written by the leaf's own task, then listed.
-    std::vector<leafwords::Words> changedWords(leaves.size());
+    // Per leaf, the voxels whose value changed and those that moved (a word per x, as the
+    // leaf's mask holds them): written by the leaf's own task, then listed.
+    std::vector<leafwords::Words> changedWords(leaves.size()), movedWords(leaves.size());
     std::atomic<std::size_t> count{0};
     const VoxelPlacement place(grid.transform());
     parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
@@ -362,19 +371,25 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                         v += float(depth);
                     }
                 }
-                if (v != old ||
+                const bool joined =
                     !(before ? before->isValueOn(openvdb::Index(pos))
-                             : acc.isValueOn(leaf.offsetToGlobalCoord(openvdb::Index(pos)))))
-                    changedWords[l][std::size_t(pos >> 6)] |= leafwords::Word(1) << (pos & 63);
+                             : acc.isValueOn(leaf.offsetToGlobalCoord(openvdb::Index(pos))));
+                const leafwords::Word bit = leafwords::Word(1) << (pos & 63);
+                if (v != old || joined) changedWords[l][std::size_t(pos >> 6)] |= bit;
+                if (std::abs(v - old) > changes.nudge || joined)
+                    movedWords[l][std::size_t(pos >> 6)] |= bit;
                 out[pos] = v;
             }
             n += std::size_t(listed);
         }
         count += n;
     });
-    for (std::size_t l = 0; l < leaves.size(); ++l)
+    for (std::size_t l = 0; l < leaves.size(); ++l) {
         if (leafwords::any(changedWords[l]))
-            changed.push_back({leaves[l]->origin(), changedWords[l]});
+            changes.changed.push_back({leaves[l]->origin(), changedWords[l]});
+        if (leafwords::any(movedWords[l]))
+            changes.moved.push_back({leaves[l]->origin(), movedWords[l]});
+    }
     if (staged) staged->changed = std::move(changedWords);
     return count;
 }
@@ -623,7 +638,7 @@ struct SegmentAdvector::Work {
     openvdb::CoordBBox region, touched;
     bool measureStretch = false;
     int bandReach = 0, reach = 0;
-    VoxelList images, mask, fresh, changed, freed;
+    VoxelList images, mask, fresh, changed, moved, freed;
     GridPtr widened; // the copies with the widened band, when it had to be widened
     std::vector<LeafNode*> sampled, moving;
 
@@ -655,7 +670,7 @@ struct SegmentAdvector::Work {
         tornWindow = (std::ceil(halfWidth) + 1) * h; // see resample
         bandReach = int(std::ceil(halfWidth)) + 1;
         widened.reset();
-        for (VoxelList* list : {&images, &mask, &fresh, &changed, &freed})
+        for (VoxelList* list : {&images, &mask, &fresh, &changed, &moved, &freed})
             list->clear();
         sampled.clear();
         moving.clear();
@@ -693,6 +708,7 @@ struct SegmentAdvector::Work {
     void copyFar(const std::vector<LeafNode*>& leaves);
     std::vector<LeafNode*> movingOf(const std::vector<LeafNode*>& leaves) const;
     std::shared_ptr<SampleSource> sourceOfSubStep(int k);
+    Changes changes();
 };
 
 // The interface voxels of the leaves the deformation moves: found leaf by leaf in parallel,
@@ -969,6 +985,15 @@ std::shared_ptr<SampleSource> SegmentAdvector::Work::sourceOfSubStep(int k) {
     return copy;
 }
 
+// Where sampling lists what it changed and moved. A change of less than a hundredth of a voxel
+// is a nudge: what a tool's falloff leaves at its edge, segment after segment. Seeding again
+// next to nudges alone let the surface creep there. One sub-step at a time, nudges add up
+// over the sub-steps: each change counts.
+Changes SegmentAdvector::Work::changes() {
+    const double nudge = options->resampleEachSubStep ? 0.0 : 0.01;
+    return {changed, moved, float(nudge * h)};
+}
+
 // Samples the moving leaves at their pre-images: the composed inverse (default) or one
 // resample per sub-step (5.3.4).
 void SegmentAdvector::Work::sample() {
@@ -991,7 +1016,8 @@ void SegmentAdvector::Work::sample() {
                     for (std::size_t i = 0; i < n; ++i)
                         y[i] = seg->inverseStep(k, x[i]);
                 },
-                tearing, tornWindow, options->sampling, changed, options->interrupter, resampling);
+                tearing, tornWindow, options->sampling, changes(), options->interrupter,
+                resampling);
             from->freeCopies();
         }
         return;
@@ -1004,7 +1030,7 @@ void SegmentAdvector::Work::sample() {
         widened ? std::make_shared<SampleSource>(*grid, widened) : SampleSource::live(*grid);
     if (!widened) staged.reserve(moving.size(), growths);
     stats.sampledVoxels = resample(*grid, moving, *from, !widened, region, map, tearing, tornWindow,
-                                   options->sampling, changed, options->interrupter, resampling,
+                                   options->sampling, changes(), options->interrupter, resampling,
                                    nullptr, widened ? nullptr : &staged);
     if (!widened) {
         staged.swapInto(moving);
@@ -1042,7 +1068,7 @@ void SegmentAdvector::Work::sample() {
         moving.insert(moving.end(), movingGrown.begin(), movingGrown.end());
         stats.sampledVoxels +=
             resample(*grid, moving, *from, !widened, region, map, tearing, tornWindow,
-                     options->sampling, changed, options->interrupter, resampling, &addedTree);
+                     options->sampling, changes(), options->interrupter, resampling, &addedTree);
         sampled = std::move(all);
     }
     from->freeCopies();
@@ -1063,14 +1089,13 @@ void SegmentAdvector::Work::fixSigns() {
 // Renormalizes only where values changed, and as far as the band reaches from there (the
 // nearest surface of a voxel nearby may have moved): where the deformation is the identity
 // (outside the tools' coatings, which fill only part of the box) the distances hold. The
-// voxels the band grew into are freed too. Seeds are recomputed only next to what changed:
-// the others are distances already, and seeding them again at every segment would let the
-// surface creep where it curves within a voxel.
+// voxels the band grew into are freed too. Seeds are recomputed only next to what moved
+// (changes()): the others are distances already, and seeding them again at every segment
+// would let the surface creep where it curves within a voxel.
 void SegmentAdvector::Work::renormalizeChanged() {
     if (!options->renormalize) return;
     freed = dilatedByCube(changed, int(std::ceil(halfWidth)) + 1);
     freed.insert(freed.end(), fresh.begin(), fresh.end());
-    VoxelList moved = changed;
     moved.insert(moved.end(), fresh.begin(), fresh.end());
     const FmmStats fmm =
         renormalize(*grid, touched, freed, moved, options->renormalization, options->interrupter);

@@ -56,9 +56,10 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region,
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
 
-// The same, where only the voxels of `moved` changed since the band was last a distance:
-// seeds are recomputed only where their stencil (the voxel and its face neighbours) holds a
-// voxel of `moved`; other seeds keep their values, as boundary.
+// The same, where only the voxels of `moved` changed since the band was last a distance
+// (advection leaves out changes of less than a hundredth of a voxel): seeds are recomputed
+// only where their stencil (the voxel and its face neighbours) holds a voxel of `moved`;
+// other seeds keep their values, as boundary.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      const VoxelList& moved, FmmOrder order = FmmOrder::Second,
                      Interrupter* interrupter = nullptr);
