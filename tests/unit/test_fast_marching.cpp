@@ -53,6 +53,17 @@ Errors compare(const Grid& g, const std::function<double(const Eigen::Vector3d&)
     return e;
 }
 
+// Renormalizes all of g and compares it with sdf (printed as `what`); no sign may flip.
+Errors renormalizedAgainst(Grid& g, const std::function<double(const Eigen::Vector3d&)>& sdf,
+                           const char* what) {
+    renormalizeAll(g);
+    const Errors e = compare(g, sdf);
+    std::printf("[ fmm ] %s, renormalized: next to the surface max error %.3f voxel, rms %.3f\n",
+                what, e.maxNear, e.rmsNear);
+    EXPECT_EQ(e.signFlips, 0u) << what;
+    return e;
+}
+
 // Scales the values by a smooth positive factor between 1.2 and 2, as a deformation
 // would leave them: the surface (the zero set) stays where it is, the distances are wrong
 // everywhere else.
@@ -711,12 +722,7 @@ TEST(FastMarching, ThinSeedsAreCappedByTheirNearestCrossing) {
     GridPtr g = gridFromSdf(rod, h, 3, openvdb::CoordBBox::createCube({-24, -24, -24}, 48));
     for (auto it = g->beginValueOn(); it; ++it)
         it.setValue(2.0f * *it);
-    renormalizeAll(*g);
-    const Errors e = compare(*g, rod);
-    std::printf("[ fmm ] a thin rod's doubled values, renormalized: next to the surface max "
-                "error %.3f voxel, rms %.3f\n",
-                e.maxNear, e.rmsNear);
-    EXPECT_EQ(e.signFlips, 0u);
+    const Errors e = renormalizedAgainst(*g, rod, "a thin rod's doubled values");
     EXPECT_LT(e.rmsNear, 0.15);
     EXPECT_LT(e.maxNear, 0.4);
 }
@@ -735,12 +741,7 @@ TEST(FastMarching, SeedsWhereTheFieldBendsComeBackToTheDistance) {
         const double d = *it / h;
         it.setValue(float((d - 0.2 * d * std::abs(d)) * h));
     }
-    renormalizeAll(*g);
-    const Errors e = compare(*g, ball);
-    std::printf("[ fmm ] a ball's values bent along the normal, renormalized: next to the "
-                "surface max error %.3f voxel, rms %.3f\n",
-                e.maxNear, e.rmsNear);
-    EXPECT_EQ(e.signFlips, 0u);
+    const Errors e = renormalizedAgainst(*g, ball, "a ball's values bent along the normal");
     EXPECT_LT(e.rmsNear, 0.045);
     EXPECT_LT(e.maxNear, 0.1);
 }
