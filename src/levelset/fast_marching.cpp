@@ -561,11 +561,12 @@ class Renormalizer {
             double inv2 = 0.0, grad2 = 0.0;
             float nearestCrossing = kInf;
             bool crossing = false, central = true;
+            std::size_t face[3][2]; // the face neighbours, -1 and +1 along each axis
             forEachAxis([&](auto a) {
                 float best = kInf;
                 float side[2] = {p, p};
                 for (const int dir : {-1, 1}) {
-                    const std::size_t j = b_.neighbour(i, dir, a);
+                    const std::size_t j = face[a][dir > 0] = b_.neighbour(i, dir, a);
                     if (j == Domain::npos) {
                         central = false;
                         continue;
@@ -608,7 +609,7 @@ class Renormalizer {
                 // voxel at times, even where the gradient passes for unit. The second-order
                 // value replaces it only downwards: where the model asks for more it is the
                 // model that straddles a rim, and raising such seeds moves the surface off.
-                if (const float d2 = std::min(secondOrderDistance(i), nearestCrossing * h);
+                if (const float d2 = std::min(secondOrderDistance(i, face), nearestCrossing * h);
                     d - d2 > float(kSecondOrderSlack) * h)
                     d = d2;
             } else {
@@ -645,48 +646,40 @@ class Renormalizer {
     // |s| h for the root s (in voxels) nearest the voxel of the quadratic model of phi along
     // its normal, phi + g s + c s^2 / 2 = 0, with g = |grad phi| and c = n^T H n (n = grad
     // phi / g) from central differences on the 3x3x3 block: a distance along the normal to
-    // second order, where phi / |grad phi| is one to first order. The first-order value where
-    // the block is incomplete, the model has no real root or it is flat.
-    float secondOrderDistance(std::size_t i) const {
+    // second order, where phi / |grad phi| is one to first order. `face` holds the voxel's six
+    // face neighbours (all in the domain, and a nonzero gradient: seed() asks only then). The
+    // first-order value where a corner of the block lies outside the domain or the model has
+    // no real root.
+    float secondOrderDistance(std::size_t i, const std::size_t (&face)[3][2]) const {
         const double p = phi(i);
         double g[3], H[3][3];
-        bool complete = true;
-        const auto at = [&](std::size_t j) {
-            if (j == Domain::npos) {
-                complete = false;
-                return 0.0;
-            }
-            return double(phi(j));
-        };
-        std::size_t face[3][2]; // the face neighbours, -1 and +1 along each axis
-        forEachAxis([&](auto a) {
-            for (const int dir : {-1, 1})
-                face[a][dir > 0] = b_.neighbour(i, dir, a);
-            const double minus = at(face[a][0]), plus = at(face[a][1]);
+        for (int a = 0; a < 3; ++a) {
+            const double minus = phi(face[a][0]), plus = phi(face[a][1]);
             g[a] = 0.5 * (plus - minus);
             H[a][a] = plus - 2.0 * p + minus;
-        });
+        }
+        const double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2], gn = std::sqrt(g2);
         // The mixed second differences, from the neighbours of the faces along the other axes.
+        bool complete = true;
         forEachAxis([&](auto b) {
             constexpr int B = decltype(b)::value;
             for (int a = 0; a < B; ++a) {
                 const auto corner = [&](int da, int db) {
-                    const std::size_t j = face[a][da > 0];
-                    return at(j == Domain::npos ? j : b_.neighbour(j, db, b));
+                    const std::size_t j = b_.neighbour(face[a][da > 0], db, b);
+                    complete &= j != Domain::npos;
+                    return j == Domain::npos ? 0.0 : double(phi(j));
                 };
                 H[a][B] = H[B][a] =
                     0.25 * (corner(1, 1) - corner(1, -1) - corner(-1, 1) + corner(-1, -1));
             }
         });
-        const double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2];
-        if (!complete || g2 < 1e-24)
-            return float(std::abs(p) / std::sqrt(std::max(g2, 1e-24)) * h_);
+        if (!complete) return float(std::abs(p) / gn * h_);
         double c = 0.0;
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < 3; ++b)
                 c += g[a] * H[a][b] * g[b];
         c /= g2;
-        const double gn = std::sqrt(g2), disc = g2 - 2.0 * c * p;
+        const double disc = g2 - 2.0 * c * p;
         // The root nearest 0, written so that it does not cancel as c goes to 0.
         const double s = disc > 0.0 ? 2.0 * std::abs(p) / (gn + std::sqrt(disc)) : std::abs(p) / gn;
         return float(s * h_);
