@@ -91,6 +91,12 @@ class StepDeformation {
     virtual Box openedBox() const { return {}; }
     // How far the tear pushes its torn set open (0 when nothing tears).
     virtual double opening() const { return 0.0; }
+    // The least value a distance to the surface can have at p before the deformation, from
+    // what the deformation knows of the shape there: a tear's torn set lies outside it (tear.h),
+    // so no distance is below minus the distance to that set. -infinity where nothing is known.
+    virtual double leastValue(const Eigen::Vector3d& /*p*/) const {
+        return -std::numeric_limits<double>::infinity();
+    }
     // A unit direction along the torn set at the point x was torn from (zero when nothing
     // tears there).
     virtual Eigen::Vector3d alongTorn(const Eigen::Vector3d& /*x*/) const {

@@ -77,6 +77,10 @@ double Tear::openedDepth(const Eigen::Vector3d& x) const {
     return open_ - (x - nearest(x)).norm();
 }
 
+double Tear::leastValue(const Eigen::Vector3d& p) const {
+    return -(p - nearest(p)).norm();
+}
+
 Eigen::Vector3d Tear::inverseStep(int, const Eigen::Vector3d& x) const {
     if (!affected_.contains(x)) return x;
     Eigen::Vector3d q = nearest(x); // not const: returned as is below

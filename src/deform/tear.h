@@ -39,6 +39,9 @@ class Tear : public StepDeformation {
     ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
                               double tolerance = 0.0) const override;
     double openedDepth(const Eigen::Vector3d& x) const override;
+    // Minus the distance from p to S: S lies outside the shape (or on its surface), and a
+    // distance is 1-Lipschitz.
+    double leastValue(const Eigen::Vector3d& p) const override;
     Box openedBox() const override { return affected_.expanded(open_ - reach_); }
     Eigen::Vector3d alongTorn(const Eigen::Vector3d& x) const override;
 

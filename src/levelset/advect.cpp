@@ -278,7 +278,11 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
 // was torn from: on a grid, what the pinch's needles bring together (or the strangle's noose
 // squeezes) keeps a membrane a few voxels thick where the exact surface meets itself at one
 // point (the grid rounds off the funnels' tips), and the tear opens through it instead of
-// keeping it as the rim of the hole.
+// keeping it as the rim of the hole. And no value sampled for a tear lies below the least
+// value the tear allows at the pre-image (StepDeformation::leastValue): the funnels the needles
+// pull (or the noose squeezes) towards the torn set are thinner than the grid resolves, so
+// it reads material next to the set where the shape has none, and the tear, which stretches
+// the space around the set by orders of magnitude, would spread that over the rim of the hole.
 // What a sampling pass lists: every voxel whose value changed or that joined the band
 // (`changed`), and of them those whose value moved by more than `nudge` (world units) or that
 // joined (`moved`): the renormalization seeds again only next to those.
@@ -363,12 +367,16 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                                                  : acc.trilinear(p);
                     };
                     v = sample(y);
-                    const double depth = tearing ? tearing->openedDepth(x) : 0.0;
-                    if (depth > 0.0) {
-                        const Eigen::Vector3d along = tearing->alongTorn(x) * (0.5 * tornWindow);
-                        for (int t = -2; t <= 2; ++t)
-                            if (t != 0) v = std::max(v, sample(y + double(t) * along));
-                        v += float(depth);
+                    if (tearing) {
+                        const double depth = tearing->openedDepth(x);
+                        if (depth > 0.0) {
+                            const Eigen::Vector3d along =
+                                tearing->alongTorn(x) * (0.5 * tornWindow);
+                            for (int t = -2; t <= 2; ++t)
+                                if (t != 0) v = std::max(v, sample(y + double(t) * along));
+                        }
+                        v = std::max(v, float(tearing->leastValue(y))) +
+                            float(std::max(0.0, depth));
                     }
                 }
                 const bool joined =

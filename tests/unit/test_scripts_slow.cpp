@@ -80,13 +80,13 @@ const std::map<std::string, Unexplained> kUnexplained = {
     {"horn", {0, 0}},
     {"mirrored_ears", {0, 4}},
     {"pinch", {0, 27}},
-    {"pinch_torus", {528, 304}},
+    {"pinch_torus", {352, 144}},
     {"pull", {0, 0}},
-    {"severed_horn", {248, 108}},
+    {"severed_horn", {248, 104}},
     {"starfish_swirls", {0, 0}},
-    {"strangle_torus", {1067, 428}},
+    {"strangle_torus", {1002, 400}},
     {"twisted_limb", {2, 2}},
-    {"two_handles", {1268, 1864}},
+    {"two_handles", {944, 1712}},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {

@@ -1,6 +1,7 @@
 // The deformations of the topology tools (thesis 3.5): the tear (3.41, 3.42), the pinch's
 // needles (3.39, 3.40) and the strangle's noose (3.43-3.45), as maps of space.
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include <gtest/gtest.h>
@@ -51,6 +52,22 @@ TEST(Tear, TheOpenedRegionTakesItsTornPointPlusItsDepth) {
     const Box opened = tear.openedBox();
     EXPECT_TRUE(opened.contains(x));
     EXPECT_FALSE(opened.contains({0.25, 0, 0}));
+}
+
+TEST(Tear, NoDistanceIsBelowMinusTheWayToTheTornSet) {
+    // The torn set lies outside the shape: a distance there is at least 0, and at most 1 lower
+    // per unit of way from it.
+    const Tear segment = Tear::alongSegment({0, -1, 0}, {0, 1, 0}, 0.2, 0.5);
+    EXPECT_NEAR(segment.leastValue({0, 0.4, 0}), 0.0, 1e-12);
+    EXPECT_NEAR(segment.leastValue({0.3, 0.4, -0.4}), -0.5, 1e-12);
+    EXPECT_NEAR(segment.leastValue({0, 1.5, 0}), -0.5, 1e-12); // past an end
+    const Tear disc = Tear::acrossDisc({0, 0, 0}, {0, 0, 2}, 0.5, 0.1, 0.4);
+    EXPECT_NEAR(disc.leastValue({0.2, 0.1, 0.25}), -0.25, 1e-12);
+    EXPECT_NEAR(disc.leastValue({0.9, 0, 0.3}), -0.5, 1e-12);
+    // A deformation that does not tear knows no bound.
+    const PinchSpec spec;
+    EXPECT_EQ(PinchNeedles(spec, 0.0, 0.5, 4).leastValue({0, 0, 0}),
+              -std::numeric_limits<double>::infinity());
 }
 
 TEST(Tear, RefusesWhatWouldFold) {

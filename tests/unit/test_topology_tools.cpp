@@ -143,6 +143,9 @@ TEST(PinchTool, MakesATorusOfASphereAtEveryVoxelSize) {
                     at.c_str(), e.meshVolume, e.referenceVolume, exactChange, e.rms / h);
         EXPECT_LT(exactChange, -0.3) << at;
         EXPECT_LT(std::abs(e.volumeError()), 0.02 * std::abs(exactChange)) << at;
+        // The hole's wall where the exact one is: the needles' funnels, thinner than the grid
+        // resolves, do not reach it as material (Tear::leastValue).
+        EXPECT_LT(e.rms / h, 0.09) << at;
     }
 }
 
