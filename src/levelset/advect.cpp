@@ -1106,7 +1106,8 @@ void SegmentAdvector::Work::renormalizeChanged() {
     freed.insert(freed.end(), fresh.begin(), fresh.end());
     moved.insert(moved.end(), fresh.begin(), fresh.end());
     const FmmStats fmm =
-        renormalize(*grid, touched, freed, moved, options->renormalization, options->interrupter);
+        renormalize(*grid, touched, freed, moved, options->renormalization, options->interrupter,
+                    seg->tears() ? BentSeeds::Either : BentSeeds::Lower);
     stats.leavesVisited += fmm.leaves;
     stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
 }

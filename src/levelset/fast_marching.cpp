@@ -379,9 +379,9 @@ constexpr int kMostSweeps = 32, kMostRounds = 100;
 class Renormalizer {
   public:
     Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
-                 const VoxelList* moved, FmmOrder order, Interrupter* interrupter)
+                 const VoxelList* moved, FmmOrder order, Interrupter* interrupter, BentSeeds bent)
         : b_(grid, region, 2, only), n_(b_.size()), h_(float(grid.voxelSize()[0])),
-          bg_(grid.background()), order_(order), interrupter_(interrupter),
+          bg_(grid.background()), order_(order), bent_(bent), interrupter_(interrupter),
           phi_(b_.leafCount(), nullptr), dist_(new float[n_]), thin_(b_.leafCount(), Bits{}),
           neg_(new Bits[b_.leafCount()]), fixed_(new Bits[b_.leafCount()]),
           settled_(new Bits[b_.leafCount()]), beyond_(new Bits[b_.leafCount()]),
@@ -607,10 +607,10 @@ class Renormalizer {
                 // fillet, a tool's edge, a tear's rim) the central differences straddle the bend
                 // and read too small a gradient, and the value errs high, by a good part of a
                 // voxel at times, even where the gradient passes for unit. The second-order
-                // value replaces it only downwards: where the model asks for more it is the
-                // model that straddles a rim, and raising such seeds moves the surface off.
-                if (const float d2 = std::min(secondOrderDistance(i, face), nearestCrossing * h);
-                    d - d2 > float(kSecondOrderSlack) * h)
+                // value replaces it downwards, or either way after a tear (BentSeeds).
+                const float d2 = std::min(secondOrderDistance(i, face), nearestCrossing * h);
+                if ((bent_ == BentSeeds::Either ? std::abs(d - d2) : d - d2) >
+                    float(kSecondOrderSlack) * h)
                     d = d2;
             } else {
                 d = float(h / std::sqrt(inv2)); // distance to the plane through the crossings
@@ -1093,6 +1093,7 @@ class Renormalizer {
     const std::size_t n_;
     const float h_, bg_;
     const FmmOrder order_;
+    const BentSeeds bent_;
     Interrupter* const interrupter_;
     // Per leaf: its values (the grid's, as they were sampled).
     std::vector<const float*> phi_;
@@ -1120,10 +1121,11 @@ class Renormalizer {
 };
 
 FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
-                          const VoxelList* moved, FmmOrder order, Interrupter* interrupter) {
+                          const VoxelList* moved, FmmOrder order, Interrupter* interrupter,
+                          BentSeeds bent = BentSeeds::Lower) {
     if (region.empty()) return {};
     pollInterrupt(interrupter);
-    Renormalizer renormalizer(grid, region, only, moved, order, interrupter);
+    Renormalizer renormalizer(grid, region, only, moved, order, interrupter, bent);
     return renormalizer.run(grid);
 }
 
@@ -1140,8 +1142,9 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelLi
 }
 
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
-                     const VoxelList& moved, FmmOrder order, Interrupter* interrupter) {
-    return renormalizeWhere(grid, region, &only, &moved, order, interrupter);
+                     const VoxelList& moved, FmmOrder order, Interrupter* interrupter,
+                     BentSeeds bent) {
+    return renormalizeWhere(grid, region, &only, &moved, order, interrupter, bent);
 }
 
 FmmStats renormalizeAll(Grid& grid, FmmOrder order, Interrupter* interrupter) {

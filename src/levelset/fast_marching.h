@@ -5,12 +5,12 @@
 //  1. seeds: every voxel with a face neighbour of the other sign gets phi / |grad phi|
 //     (central differences), capped by the distance to its nearest axis crossing, or the
 //     root of the second-order model of phi along the normal where that lies more than a
-//     twentieth of a voxel lower (the field bends within the voxel). Values
-//     whose gradient is already unit within 1%, and values on or within two voxels of a
-//     feature one voxel thin (but for that cap), are kept, and so are seeds whose stencil a
-//     deformation did not change (the `moved` overload): the estimate is not idempotent where
-//     the surface curves within a voxel, and an interface seeded again and again would creep.
-//     The sign of every voxel is kept.
+//     twentieth of a voxel lower (the field bends within the voxel; after a tear, lower or
+//     higher: BentSeeds). Values whose gradient is already unit within 1%, and values on or
+//     within two voxels of a feature one voxel thin (but for that cap), are kept, and so are
+//     seeds whose stencil a deformation did not change (the `moved` overload): the estimate
+//     is not idempotent where the surface curves within a voxel, and an interface seeded
+//     again and again would creep. The sign of every voxel is kept.
 //  2. every other voxel gets the upwind solution from its neighbours of its own side: the
 //     first-order stencil, or the second-order one (HAFMM) where the voxel beyond the upwind
 //     neighbour is closer still. These are solved leaf by leaf, the leaves of one parity
@@ -35,6 +35,14 @@
 namespace sweepers {
 
 enum class FmmOrder { First = 1, Second = 2 };
+
+// Which way a seed's second-order value may replace its first-order one. Lower: only
+// downwards, after smooth deformations, where a higher second-order value is the quadratic
+// model straddling a rim or a ridge, and taking it costs the interface accuracy. Either:
+// after a tear, which compresses space towards the rim of the hole and stretches it around
+// the rim by orders of magnitude: central differences there straddle the steep inside and
+// read too large a gradient, and the first-order seeds lie too shallow.
+enum class BentSeeds { Lower, Either };
 
 struct FmmStats {
     std::size_t seeds = 0;
@@ -62,7 +70,7 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelLi
 // other seeds keep their values, as boundary.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      const VoxelList& moved, FmmOrder order = FmmOrder::Second,
-                     Interrupter* interrupter = nullptr);
+                     Interrupter* interrupter = nullptr, BentSeeds bent = BentSeeds::Lower);
 // Renormalizes the whole active band.
 FmmStats renormalizeAll(Grid& grid, FmmOrder order = FmmOrder::Second,
                         Interrupter* interrupter = nullptr);

@@ -80,13 +80,13 @@ const std::map<std::string, Unexplained> kUnexplained = {
     {"horn", {0, 0}},
     {"mirrored_ears", {0, 4}},
     {"pinch", {0, 27}},
-    {"pinch_torus", {352, 144}},
+    {"pinch_torus", {248, 112}},
     {"pull", {0, 0}},
-    {"severed_horn", {248, 104}},
+    {"severed_horn", {52, 72}},
     {"starfish_swirls", {0, 0}},
-    {"strangle_torus", {1002, 400}},
+    {"strangle_torus", {480, 267}},
     {"twisted_limb", {2, 2}},
-    {"two_handles", {944, 1712}},
+    {"two_handles", {360, 446}},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
