@@ -266,23 +266,6 @@ void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
         it.setValue(live.getValue(it.getCoord()) < 0.0f ? -far : far);
 }
 
-// Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
-// the pre-image of x (`map(x, n, y, scratch)` maps a leaf's n voxels x at once, into y), and lists
-// in `changes` the voxels whose value changed, and those that moved by more than a nudge, a leaf
-// at a time (a leaf resampled again is listed again). When the source holds the grid's own values
-// (`sourceIsGrid`: no widened band), a voxel that the map leaves in place keeps its value
-// without interpolating: a sample at a voxel centre returns it exactly. With `staged`, the
-// new values go there and the leaves keep theirs.
-// A deformation that tears space (`tearing`) adds how deep x lies in what it opened. A point
-// it opened reads the largest value along the torn set within `tornWindow` of the point it
-// was torn from: on a grid, what the pinch's needles bring together (or the strangle's noose
-// squeezes) keeps a membrane a few voxels thick where the exact surface meets itself at one
-// point (the grid rounds off the funnels' tips), and the tear opens through it instead of
-// keeping it as the rim of the hole. And no value sampled for a tear lies below the least
-// value the tear allows at the pre-image (StepDeformation::leastValue): the funnels the needles
-// pull (or the noose squeezes) towards the torn set are thinner than the grid resolves, so
-// it reads material next to the set where the shape has none, and the tear, which stretches
-// the space around the set by orders of magnitude, would spread that over the rim of the hole.
 // What a sampling pass lists: every voxel whose value changed or that joined the band
 // (`changed`), and of them those whose value moved by more than `nudge` (world units) or that
 // joined (`moved`): the renormalization seeds again only next to those.
@@ -302,6 +285,24 @@ struct ResampleScratch {
 };
 using ResampleScratches = tbb::enumerable_thread_specific<ResampleScratch>;
 
+// Resamples every active voxel inside `box` of the given leaves of `grid` from `source` at
+// the pre-image of x (`map(x, n, y, scratch)` maps a leaf's n voxels x at once, into y), and lists
+// in `changes` the voxels whose value changed, and those that moved by more than a nudge, a leaf
+// at a time (a leaf resampled again is listed again). When the source holds the grid's own values
+// (`sourceIsGrid`: no widened band), a voxel that the map leaves in place keeps its value
+// without interpolating: a sample at a voxel centre returns it exactly. With `staged`, the
+// new values go there and the leaves keep theirs.
+//
+// A deformation that tears space (`tearing`) adds how deep x lies in what it opened. A point
+// it opened reads the largest value along the torn set within `tornWindow` of the point it
+// was torn from: on a grid, what the pinch's needles bring together (or the strangle's noose
+// squeezes) keeps a membrane a few voxels thick where the exact surface meets itself at one
+// point (the grid rounds off the funnels' tips), and the tear opens through it instead of
+// keeping it as the rim of the hole. And no value sampled for a tear lies below the least
+// value the tear allows at the pre-image (StepDeformation::leastValue): the funnels the needles
+// pull (or the noose squeezes) towards the torn set are thinner than the grid resolves, so
+// it reads material next to the set where the shape has none, and the tear, which stretches
+// the space around the set by orders of magnitude, would spread that over the rim of the hole.
 template <typename Map>
 std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const SampleSource& source,
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
