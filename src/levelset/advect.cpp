@@ -1106,11 +1106,21 @@ void SegmentAdvector::Work::renormalizeChanged() {
     freed = dilatedByCube(changed, int(std::ceil(halfWidth)) + 1);
     freed.insert(freed.end(), fresh.begin(), fresh.end());
     moved.insert(moved.end(), fresh.begin(), fresh.end());
-    const FmmStats fmm =
-        renormalize(*grid, touched, freed, moved, options->renormalization, options->interrupter,
-                    seg->tears() ? BentSeeds::Either : BentSeeds::Lower);
-    stats.leavesVisited += fmm.leaves;
-    stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
+    const auto pass = [&](Seeding seeding) {
+        const FmmStats fmm = renormalize(*grid, touched, freed, moved, options->renormalization,
+                                         options->interrupter, seeding);
+        stats.leavesVisited += fmm.leaves;
+        stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
+    };
+    if (!seg->tears()) {
+        pass(Seeding::Lower);
+        return;
+    }
+    // A tear's seeds come from a field whose slope varies by orders of magnitude around the
+    // rim: the first pass puts the surface where the tear leaves it, the second seeds the
+    // same voxels from that surface (Seeding says why).
+    pass(Seeding::Either);
+    pass(Seeding::Interface);
 }
 
 // Sampling changed the band's voxels in `changed` and switched on those of `fresh`;

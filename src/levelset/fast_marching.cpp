@@ -21,6 +21,7 @@
 
 #include "levelset/leaf_box.h"
 #include "levelset/leaf_words.h"
+#include "levelset/linear_surface.h"
 #include "levelset/local_tree.h"
 #include "levelset/upwind_row.h"
 
@@ -379,9 +380,9 @@ constexpr int kMostSweeps = 32, kMostRounds = 100;
 class Renormalizer {
   public:
     Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
-                 const VoxelList* moved, FmmOrder order, Interrupter* interrupter, BentSeeds bent)
+                 const VoxelList* moved, FmmOrder order, Interrupter* interrupter, Seeding seeding)
         : b_(grid, region, 2, only), n_(b_.size()), h_(float(grid.voxelSize()[0])),
-          bg_(grid.background()), order_(order), bent_(bent), interrupter_(interrupter),
+          bg_(grid.background()), order_(order), seeding_(seeding), interrupter_(interrupter),
           phi_(b_.leafCount(), nullptr), dist_(new float[n_]), thin_(b_.leafCount(), Bits{}),
           neg_(new Bits[b_.leafCount()]), fixed_(new Bits[b_.leafCount()]),
           settled_(new Bits[b_.leafCount()]), beyond_(new Bits[b_.leafCount()]),
@@ -552,7 +553,9 @@ class Renormalizer {
     // 1. Seeds (voxels with a face neighbour across the surface): phi / |grad phi| with
     //    central differences, which turns a sampled field that is no longer a distance back
     //    into one to second order where the field is smooth, capped by the distance to the
-    //    nearest axis crossing (the surface is no farther). The sign is always kept.
+    //    nearest axis crossing (the surface is no farther); in a second pass (Seeding::
+    //    Interface), the distance to the linear surface through the crossings. The sign is
+    //    always kept.
     std::size_t seed() {
         tbb::enumerable_thread_specific<std::size_t> count(0);
         const float h = h_;
@@ -596,6 +599,10 @@ class Renormalizer {
                 // but capped by the distance to its nearest axis crossing, as every seed is: a
                 // value sampled from a stretched field may exceed it, and no distance does.
                 d = std::min(std::abs(p), nearestCrossing * h);
+            } else if (const float s =
+                           seeding_ == Seeding::Interface ? linearSurfaceDistance(i, face) : kInf;
+                       s < kInf) {
+                d = s; // no farther than the nearest crossing: the surface passes through it
             } else if (grad2 > 1e-12 * double(h) * h) {
                 const double gradNorm = std::sqrt(grad2) / h;
                 // A value whose gradient is already unit within kUnitSlack is a distance: kept,
@@ -607,9 +614,9 @@ class Renormalizer {
                 // fillet, a tool's edge, a tear's rim) the central differences straddle the bend
                 // and read too small a gradient, and the value errs high, by a good part of a
                 // voxel at times, even where the gradient passes for unit. The second-order
-                // value replaces it downwards, or either way after a tear (BentSeeds).
+                // value replaces it downwards, or either way after a tear (Seeding).
                 const float d2 = std::min(secondOrderDistance(i, face), nearestCrossing * h);
-                if ((bent_ == BentSeeds::Either ? std::abs(d - d2) : d - d2) >
+                if ((seeding_ == Seeding::Either ? std::abs(d - d2) : d - d2) >
                     float(kSecondOrderSlack) * h)
                     d = d2;
             } else {
@@ -641,6 +648,24 @@ class Renormalizer {
             count.local() += n;
         });
         return count.combine(std::plus<>());
+    }
+
+    // The distance to the linear surface through the crossings of the 3x3x3 block around
+    // voxel i (linear_surface.h), given its six face neighbours; +infinity where a voxel of
+    // the block lies outside the domain.
+    float linearSurfaceDistance(std::size_t i, const std::size_t (&face)[3][2]) const {
+        Block27 block;
+        for (int x = -1; x <= 1; ++x)
+            for (int y = -1; y <= 1; ++y)
+                for (int z = -1; z <= 1; ++z) {
+                    // Step along x (from the face table), then y, then z.
+                    std::size_t j = x != 0 ? face[0][x > 0] : i;
+                    if (y != 0 && j != Domain::npos) j = b_.neighbour(j, y, Axis<1>{});
+                    if (z != 0 && j != Domain::npos) j = b_.neighbour(j, z, Axis<2>{});
+                    if (j == Domain::npos) return kInf;
+                    block[(x + 1) * 9 + (y + 1) * 3 + (z + 1)] = phi(j);
+                }
+        return distanceToLinearSurface(block) * h_;
     }
 
     // |s| h for the root s (in voxels) nearest the voxel of the quadratic model of phi along
@@ -1093,7 +1118,7 @@ class Renormalizer {
     const std::size_t n_;
     const float h_, bg_;
     const FmmOrder order_;
-    const BentSeeds bent_;
+    const Seeding seeding_;
     Interrupter* const interrupter_;
     // Per leaf: its values (the grid's, as they were sampled).
     std::vector<const float*> phi_;
@@ -1122,10 +1147,10 @@ class Renormalizer {
 
 FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
                           const VoxelList* moved, FmmOrder order, Interrupter* interrupter,
-                          BentSeeds bent = BentSeeds::Lower) {
+                          Seeding seeding = Seeding::Lower) {
     if (region.empty()) return {};
     pollInterrupt(interrupter);
-    Renormalizer renormalizer(grid, region, only, moved, order, interrupter, bent);
+    Renormalizer renormalizer(grid, region, only, moved, order, interrupter, seeding);
     return renormalizer.run(grid);
 }
 
@@ -1143,8 +1168,8 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelLi
 
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      const VoxelList& moved, FmmOrder order, Interrupter* interrupter,
-                     BentSeeds bent) {
-    return renormalizeWhere(grid, region, &only, &moved, order, interrupter, bent);
+                     Seeding seeding) {
+    return renormalizeWhere(grid, region, &only, &moved, order, interrupter, seeding);
 }
 
 FmmStats renormalizeAll(Grid& grid, FmmOrder order, Interrupter* interrupter) {

@@ -6,7 +6,8 @@
 //     (central differences), capped by the distance to its nearest axis crossing, or the
 //     root of the second-order model of phi along the normal where that lies more than a
 //     twentieth of a voxel lower (the field bends within the voxel; after a tear, lower or
-//     higher: BentSeeds). Values whose gradient is already unit within 1%, and values on or
+//     higher), or, in a second pass after a tear, the distance to the surface the values
+//     place (Seeding). Values whose gradient is already unit within 1%, and values on or
 //     within two voxels of a feature one voxel thin (but for that cap), are kept, and so are
 //     seeds whose stencil a deformation did not change (the `moved` overload): the estimate
 //     is not idempotent where the surface curves within a voxel, and an interface seeded
@@ -36,13 +37,21 @@ namespace sweepers {
 
 enum class FmmOrder { First = 1, Second = 2 };
 
-// Which way a seed's second-order value may replace its first-order one. Lower: only
-// downwards, after smooth deformations, where a higher second-order value is the quadratic
-// model straddling a rim or a ridge, and taking it costs the interface accuracy. Either:
-// after a tear, which compresses space towards the rim of the hole and stretches it around
-// the rim by orders of magnitude: central differences there straddle the steep inside and
-// read too large a gradient, and the first-order seeds lie too shallow.
-enum class BentSeeds { Lower, Either };
+// How seeds are estimated.
+//  Lower: a seed's second-order value replaces its first-order one only downwards, after
+//    smooth deformations, where a higher second-order value is the quadratic model straddling
+//    a rim or a ridge, and taking it costs the interface accuracy.
+//  Either: either way, after a tear, which compresses space towards the rim of the hole and
+//    stretches it around the rim by orders of magnitude: central differences there straddle
+//    the steep inside and read too large a gradient, and the first-order seeds lie too
+//    shallow.
+//  Interface: the distance to the linear surface through the values' crossings
+//    (linear_surface.h), whatever the gradient reads; thin seeds are kept, as always. For a
+//    second pass over a field that is a distance already: after a tear's first pass its
+//    surface is where the tear put it, but its seeds, estimated from a field whose slope
+//    varies by orders of magnitude within a few voxels, still disagree with one another by a
+//    tenth to a third of a voxel, more than the surface's distance does from voxel to voxel.
+enum class Seeding { Lower, Either, Interface };
 
 struct FmmStats {
     std::size_t seeds = 0;
@@ -70,7 +79,7 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelLi
 // other seeds keep their values, as boundary.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      const VoxelList& moved, FmmOrder order = FmmOrder::Second,
-                     Interrupter* interrupter = nullptr, BentSeeds bent = BentSeeds::Lower);
+                     Interrupter* interrupter = nullptr, Seeding seeding = Seeding::Lower);
 // Renormalizes the whole active band.
 FmmStats renormalizeAll(Grid& grid, FmmOrder order = FmmOrder::Second,
                         Interrupter* interrupter = nullptr);

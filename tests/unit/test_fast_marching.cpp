@@ -18,6 +18,7 @@
 #include "levelset/fast_marching.h"
 #include "levelset/leaf_words.h"
 #include "levelset/local_tree.h"
+#include "levelset/peer_check.h"
 #include "levelset/upwind_row.h"
 
 using namespace sweepers;
@@ -755,7 +756,7 @@ TEST(FastMarching, SeedsWhereTheFieldBendsComeBackToTheDistance) {
 // After a tear the field is the other way round: it steepens away from the surface (the tear
 // compresses space towards the rim of the hole), phi = d + a d |d|, the central gradient
 // next to the surface exceeds 1, and phi / |grad phi| lies too shallow. Seeds of a ball bent
-// so (a = 0.2), renormalized as after a tear (BentSeeds::Either), come back next to the
+// so (a = 0.2), renormalized as after a tear (Seeding::Either), come back next to the
 // surface within 0.045 voxel RMS and 0.1 at most; as after a smooth deformation (Lower: the
 // second-order value only downwards) they stay as shallow as the first-order value leaves
 // them.
@@ -766,11 +767,11 @@ TEST(FastMarching, AfterATearSeedsComeBackUpToTheDistance) {
         all.push_back(activeVoxelsOf(*leaf));
     openvdb::CoordBBox region = bent->evalActiveVoxelBoundingBox();
     region.expand(2);
-    for (const BentSeeds way : {BentSeeds::Either, BentSeeds::Lower}) {
+    for (const Seeding way : {Seeding::Either, Seeding::Lower}) {
         GridPtr g = bent->deepCopy();
         renormalize(*g, region, all, all, FmmOrder::Second, nullptr, way);
         const Errors e = compare(*g, kBall);
-        const bool either = way == BentSeeds::Either;
+        const bool either = way == Seeding::Either;
         std::printf("[ fmm ] a ball's values steepened along the normal, seeds %s: next to the "
                     "surface max error %.3f voxel, rms %.3f\n",
                     either ? "either way" : "lower only", e.maxNear, e.rmsNear);
@@ -782,4 +783,41 @@ TEST(FastMarching, AfterATearSeedsComeBackUpToTheDistance) {
             EXPECT_GT(e.rmsNear, 0.045);
         }
     }
+}
+
+// After a tear the inside of the rim is steeper than the outside, the more so the deeper
+// (the tear compresses space towards the rim), and by a factor that varies along the rim. A
+// ball whose inside values were bent so, phi = s (d - d^2 / 2) (d the distance in voxels, s
+// between 1 and 5, varying over some ten voxels along the surface), renormalized as after a
+// tear: the first pass (Seeding::Either) leaves seeds that disagree with one another, and
+// OpenVDB's eikonal test refuses some; the second, seeded from the surface the first placed
+// (Seeding::Interface), leaves none refused, and its surface is no farther from the ball's.
+TEST(FastMarching, AfterATearASecondPassSeedsFromTheSurface) {
+    const double h = 1.0 / 32;
+    GridPtr torn = gridFromSdf(kBall, h, 3, openvdb::CoordBBox::createCube({-20, -20, -20}, 40));
+    for (auto it = torn->beginValueOn(); it; ++it) {
+        if (*it >= 0.0f) continue;
+        const Eigen::Vector3d p = toEigen(torn->indexToWorld(it.getCoord()));
+        const double s = 3.0 + 2.0 * std::sin(20.0 * p.x() + 16.0 * p.y()) * std::cos(18.0 * p.z());
+        const double d = *it / h;
+        it.setValue(float((d - 0.5 * d * d) * s * h));
+    }
+    VoxelList all;
+    for (auto leaf = torn->tree().cbeginLeaf(); leaf; ++leaf)
+        all.push_back(activeVoxelsOf(*leaf));
+    openvdb::CoordBBox region = torn->evalActiveVoxelBoundingBox();
+    region.expand(2);
+    GridPtr once = torn->deepCopy();
+    renormalize(*once, region, all, all, FmmOrder::Second, nullptr, Seeding::Either);
+    GridPtr twice = once->deepCopy();
+    renormalize(*twice, region, all, all, FmmOrder::Second, nullptr, Seeding::Interface);
+    const PeerCheck first = peerCheck(*once), second = peerCheck(*twice);
+    const Errors e1 = compare(*once, kBall), e2 = compare(*twice, kBall);
+    std::printf("[ fmm ] a ball steepened inside unevenly: refused %zu after the first pass, %zu "
+                "after the second; next to the surface rms %.3f, %.3f voxel\n",
+                first.eikonal, second.eikonal, e1.rmsNear, e2.rmsNear);
+    EXPECT_GT(first.eikonal, 20u); // the case is there
+    EXPECT_EQ(second.eikonal, 0u);
+    EXPECT_EQ(e2.signFlips, 0u);
+    EXPECT_LE(e2.rmsNear, e1.rmsNear);
 }

@@ -8,7 +8,9 @@
 #include <openvdb/tools/LevelSetMeasure.h>
 
 #include "deform/sweep.h"
+#include "grids.h"
 #include "levelset/advect.h"
+#include "levelset/create.h"
 #include "levelset/measure.h"
 #include "mesh/marching_cubes.h"
 #include "mesh/mc_table.h"

@@ -80,13 +80,13 @@ const std::map<std::string, Unexplained> kUnexplained = {
     {"horn", {0, 0}},
     {"mirrored_ears", {0, 4}},
     {"pinch", {0, 27}},
-    {"pinch_torus", {248, 112}},
+    {"pinch_torus", {68, 41}},
     {"pull", {0, 0}},
-    {"severed_horn", {52, 72}},
+    {"severed_horn", {14, 44}},
     {"starfish_swirls", {0, 0}},
-    {"strangle_torus", {480, 267}},
+    {"strangle_torus", {379, 187}},
     {"twisted_limb", {2, 2}},
-    {"two_handles", {360, 446}},
+    {"two_handles", {96, 82}},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
