@@ -897,8 +897,34 @@ void SegmentAdvector::Work::widenSource() {
     for (LeafNode* leaf : leavesIn(source->tree(), box))
         if (!grid->tree().probeConstLeaf(leaf->origin())) // not a copy
             farWithSigns(*leaf, float(needed * h), live);
-    renormalize(*source, indexBox(*grid, seg->affectedBox(), int(needed) + 1), FmmOrder::First,
-                options->interrupter);
+    // Sampling reads every leaf from the widened copy, so a voxel the deformation leaves in
+    // place must find its own value there: the copy's band is renormalized only where the
+    // deformation moves it, and where the widening added voxels. Renormalizing it all seeded
+    // the still band again at every segment, and the surface crept where it curves within a
+    // voxel, across the whole affected box (as renormalizeChanged() says), over the many
+    // segments of a stroke whose noose or needles call for a wider band.
+    const std::vector<LeafNode*> copied = leavesIn(source->tree(), box);
+    VoxelList redo(copied.size());
+    parallelFor(std::size_t(0), copied.size(), [&](std::size_t l) {
+        const LeafNode& leaf = *copied[l];
+        LeafVoxels& entry = redo[l];
+        entry.origin = leaf.origin();
+        const LeafNode* old = grid->tree().probeConstLeaf(leaf.origin());
+        for (int x = 0; x < 8; ++x) {
+            const auto on = leaf.getValueMask().getWord<leafwords::Word>(x);
+            entry.words[std::size_t(x)] =
+                old ? on & ~old->getValueMask().getWord<leafwords::Word>(x) : on;
+        }
+        if (!old || still(*old)) return;
+        for (auto it = old->cbeginValueOn(); it; ++it)
+            if (!seg->stillAt(toEigen(grid->indexToWorld(it.getCoord()))))
+                entry.words[it.pos() >> 6] |= leafwords::Word(1) << (it.pos() & 63);
+    });
+    redo.erase(std::remove_if(redo.begin(), redo.end(),
+                              [](const LeafVoxels& e) { return !leafwords::any(e.words); }),
+               redo.end());
+    renormalize(*source, indexBox(*grid, seg->affectedBox(), int(needed) + 1), redo, redo,
+                FmmOrder::First, options->interrupter);
     widened = source;
 }
 

@@ -10,6 +10,7 @@
 
 #include "deform/inflate.h"
 #include "deform/pinch.h"
+#include "deform/strangle.h"
 #include "deform/swirl.h"
 #include "grids.h"
 #include "io/start_grid.h"
@@ -602,4 +603,43 @@ TEST(Advect, ASlowStrokeDoesNotCreep) {
                 "voxels\n",
                 segments, radius, end, rms);
     EXPECT_LT(rms, 0.15);
+}
+
+// Where the band is widened, sampling reads every leaf from the widened copy: a voxel the
+// deformation leaves in place must read its own value there. Sampling alone (no
+// renormalization), every still voxel of a strangle's segments keeps its value to the bit;
+// renormalizing the whole copy had seeded the still band again at every segment, and its
+// surface crept where nothing moved it.
+TEST(Advect, AWidenedBandGivesStillVoxelsTheirOwnValues) {
+    const double h = 1.0 / 32;
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3);
+    StrangleSpec noose;
+    noose.at = Eigen::Vector3d(0.78, 0, 0);
+    noose.axis = Eigen::Vector3d::UnitZ();
+    noose.size = 0.9;
+    noose.falloff = 0.25;
+    noose.open = 0.3;
+    const auto parts = planStrangle(noose, h);
+    AdvectOptions sampleOnly;
+    sampleOnly.renormalize = false;
+    std::size_t widened = 0, still = 0, changed = 0;
+    for (std::size_t j = 0; j + 1 < parts.size(); ++j) {
+        const GridPtr before = g->deepCopy();
+        const AdvectStats stats = advectSegment(*g, *parts[j], sampleOnly);
+        widened += stats.leavesWidened > 0;
+        const auto now = g->getConstAccessor();
+        for (auto it = before->cbeginValueOn(); it; ++it) {
+            if (!it.isVoxelValue() ||
+                !parts[j]->stillAt(toEigen(before->indexToWorld(it.getCoord()))))
+                continue;
+            ++still;
+            changed += now.getValue(it.getCoord()) != *it;
+        }
+    }
+    std::printf("[ advect ] a strangle's %zu segments, %zu of them widened: %zu still voxels, "
+                "%zu changed\n",
+                parts.size() - 1, widened, still, changed);
+    EXPECT_GT(widened, 0u);
+    EXPECT_GT(still, 10000u);
+    EXPECT_EQ(changed, 0u);
 }

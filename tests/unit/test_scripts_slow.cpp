@@ -82,11 +82,11 @@ const std::map<std::string, Unexplained> kUnexplained = {
     {"pinch", {0, 27}},
     {"pinch_torus", {68, 41}},
     {"pull", {0, 0}},
-    {"severed_horn", {14, 44}},
+    {"severed_horn", {14, 36}},
     {"starfish_swirls", {0, 0}},
-    {"strangle_torus", {379, 187}},
+    {"strangle_torus", {90, 48}},
     {"twisted_limb", {2, 2}},
-    {"two_handles", {96, 82}},
+    {"two_handles", {96, 81}},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
