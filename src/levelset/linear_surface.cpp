@@ -26,7 +26,9 @@ double tetrahedronDistance(const Vec (&p)[4], const float (&v)[4]) {
         (inside(v[k]) ? in[nIn++] : out[nOut++]) = k;
     if (nIn == 0 || nOut == 0) return std::numeric_limits<double>::infinity();
     const auto crossing = [&](int a, int b) {
-        const double t = double(v[a]) / (double(v[a]) - double(v[b]));
+        // Both ends 0 (-0 inside, +0 outside): the edge lies on the surface, any point of it.
+        const double step = double(v[a]) - double(v[b]);
+        const double t = step != 0.0 ? double(v[a]) / step : 0.5;
         return p[a] + (p[b] - p[a]) * t;
     };
     const Vec origin(0.0, 0.0, 0.0);

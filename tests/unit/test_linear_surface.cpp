@@ -46,9 +46,17 @@ TEST(LinearSurface, NoneWhereNoValueChangesSign) {
     Block27 block;
     fill(block, [](int x, int y, int z) { return 2.0 + 0.5 * x + 0.25 * y - 0.5 * z; });
     EXPECT_EQ(distanceToLinearSurface(block), std::numeric_limits<float>::infinity());
-    // -0 reads as inside: a voxel exactly on the surface counts on the inside, as seeding has it.
-    fill(block, [](int x, int y, int z) { return x == 1 ? -0.0 : 1.0 + y * 0.0 + z * 0.0; });
+}
+
+// -0 reads as inside, as seeding reads it; an edge from -0 to +0 lies on the surface.
+TEST(LinearSurface, MinusZeroIsInside) {
+    Block27 block;
+    fill(block, [](int x, int, int) { return x == 1 ? -0.0 : 1.0; });
     EXPECT_NEAR(distanceToLinearSurface(block), 1.0f, 1e-6f);
+    fill(block, [](int x, int, int) { return x == 1 ? -0.0 : 0.0; });
+    const float d = distanceToLinearSurface(block);
+    EXPECT_FALSE(std::isnan(d));
+    EXPECT_LE(d, 1.0f);
 }
 
 // Next to a sphere of radius R voxels, the linear surface through its distance's crossings
