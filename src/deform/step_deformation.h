@@ -97,6 +97,11 @@ class StepDeformation {
     virtual double leastValue(const Eigen::Vector3d& /*p*/) const {
         return -std::numeric_limits<double>::infinity();
     }
+    // Whether sampling carries the value it reads inside the opening (the largest along the
+    // torn set around a point's pre-image: advect.cpp, resample) past the opening's rim,
+    // less the distance to the rim: where the membrane the grid keeps where the surface meets
+    // itself reaches past the rim too. False when nothing tears.
+    virtual bool windowPastRim() const { return false; }
     // A unit direction along the torn set at the point x was torn from (zero when nothing
     // tears there).
     virtual Eigen::Vector3d alongTorn(const Eigen::Vector3d& /*x*/) const {

@@ -44,6 +44,12 @@ class Tear : public StepDeformation {
     double leastValue(const Eigen::Vector3d& p) const override;
     Box openedBox() const override { return affected_.expanded(open_ - reach_); }
     Eigen::Vector3d alongTorn(const Eigen::Vector3d& x) const override;
+    // Along a segment: where the pinch's needles meet, the grid rounds the membrane off past
+    // the rim as well, and the hole's wall there read it as material (a ring on the wall near
+    // the hole's middle, half a voxel high). Not across a disc: there the window reads along
+    // the disc, outwards, where the strangle's neck has air beside it, and past the rim that
+    // eats into the wall.
+    bool windowPastRim() const override { return set_ == Set::Segment; }
 
   private:
     enum class Set { Segment, Disc };

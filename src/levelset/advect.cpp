@@ -298,11 +298,14 @@ using ResampleScratches = tbb::enumerable_thread_specific<ResampleScratch>;
 // was torn from: on a grid, what the pinch's needles bring together (or the strangle's noose
 // squeezes) keeps a membrane a few voxels thick where the exact surface meets itself at one
 // point (the grid rounds off the funnels' tips), and the tear opens through it instead of
-// keeping it as the rim of the hole. And no value sampled for a tear lies below the least
-// value the tear allows at the pre-image (StepDeformation::leastValue): the funnels the needles
-// pull (or the noose squeezes) towards the torn set are thinner than the grid resolves, so
-// it reads material next to the set where the shape has none, and the tear, which stretches
-// the space around the set by orders of magnitude, would spread that over the rim of the hole.
+// keeping it as the rim of the hole. Where the tear asks (StepDeformation::windowPastRim),
+// points within the window's reach past the rim read that value less their distance to the
+// rim, when it is more than their own. And no value sampled for a tear lies below the least
+// value the tear allows at the pre-image (StepDeformation::leastValue): the funnels the
+// needles pull (or the noose squeezes) towards the torn set are thinner than the grid
+// resolves, so it reads material next to the set where the shape has none, and the tear,
+// which stretches the space around the set by orders of magnitude, would spread that over
+// the rim of the hole.
 template <typename Map>
 std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const SampleSource& source,
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
@@ -314,6 +317,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     std::vector<leafwords::Words> changedWords(leaves.size()), movedWords(leaves.size());
     std::atomic<std::size_t> count{0};
     const VoxelPlacement place(grid.transform());
+    const bool windowPastRim = tearing && tearing->windowPastRim();
     parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
         const SampleSource::Accessor acc(source);
         ResampleScratch& s = scratch.local();
@@ -370,11 +374,16 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                     v = sample(y);
                     if (tearing) {
                         const double depth = tearing->openedDepth(x);
-                        if (depth > 0.0) {
+                        if (depth > 0.0 || (windowPastRim && depth > -tornWindow)) {
                             const Eigen::Vector3d along =
                                 tearing->alongTorn(x) * (0.5 * tornWindow);
+                            float window = v;
                             for (int t = -2; t <= 2; ++t)
-                                if (t != 0) v = std::max(v, sample(y + double(t) * along));
+                                if (t != 0)
+                                    window = std::max(window, sample(y + double(t) * along));
+                            // Past the rim the window's value falls off as the distance to the
+                            // rim, as a distance would from a wall on the rim (1-Lipschitz).
+                            v = std::max(v, window + float(std::min(0.0, depth)));
                         }
                         v = std::max(v, float(tearing->leastValue(y))) +
                             float(std::max(0.0, depth));

@@ -80,13 +80,13 @@ const std::map<std::string, Unexplained> kUnexplained = {
     {"horn", {0, 0}},
     {"mirrored_ears", {0, 4}},
     {"pinch", {0, 27}},
-    {"pinch_torus", {68, 41}},
+    {"pinch_torus", {104, 0}},
     {"pull", {0, 0}},
     {"severed_horn", {14, 36}},
     {"starfish_swirls", {0, 0}},
-    {"strangle_torus", {90, 48}},
+    {"strangle_torus", {140, 113}},
     {"twisted_limb", {2, 2}},
-    {"two_handles", {96, 81}},
+    {"two_handles", {46, 151}},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
