@@ -903,7 +903,8 @@ void SegmentAdvector::Work::widenSource() {
     }
     // Leaves the dilation added hold the copies' background, whatever the side.
     const auto live = grid->getConstAccessor();
-    for (LeafNode* leaf : leavesIn(source->tree(), box))
+    const std::vector<LeafNode*> copied = leavesIn(source->tree(), box);
+    for (LeafNode* leaf : copied)
         if (!grid->tree().probeConstLeaf(leaf->origin())) // not a copy
             farWithSigns(*leaf, float(needed * h), live);
     // Sampling reads every leaf from the widened copy, so a voxel the deformation leaves in
@@ -912,7 +913,6 @@ void SegmentAdvector::Work::widenSource() {
     // the still band again at every segment, and the surface crept where it curves within a
     // voxel, across the whole affected box (as renormalizeChanged() says), over the many
     // segments of a stroke whose noose or needles call for a wider band.
-    const std::vector<LeafNode*> copied = leavesIn(source->tree(), box);
     VoxelList redo(copied.size());
     parallelFor(std::size_t(0), copied.size(), [&](std::size_t l) {
         const LeafNode& leaf = *copied[l];

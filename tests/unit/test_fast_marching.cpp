@@ -222,6 +222,16 @@ GridPtr bentBall(double a) {
     return g;
 }
 
+// Renormalizes every active voxel of g, all of them counted as moved, seeded `seeding`'s way.
+void renormalizeAllMoved(Grid& g, Seeding seeding) {
+    VoxelList all;
+    for (auto leaf = g.tree().cbeginLeaf(); leaf; ++leaf)
+        all.push_back(activeVoxelsOf(*leaf));
+    openvdb::CoordBBox region = g.evalActiveVoxelBoundingBox();
+    region.expand(2);
+    renormalize(g, region, all, all, FmmOrder::Second, nullptr, seeding);
+}
+
 } // namespace
 
 TEST(FastMarching, SolvesTheUpwindEquationsAcrossLeaves) {
@@ -762,14 +772,9 @@ TEST(FastMarching, SeedsWhereTheFieldBendsComeBackToTheDistance) {
 // them.
 TEST(FastMarching, AfterATearSeedsComeBackUpToTheDistance) {
     const GridPtr bent = bentBall(0.2);
-    VoxelList all;
-    for (auto leaf = bent->tree().cbeginLeaf(); leaf; ++leaf)
-        all.push_back(activeVoxelsOf(*leaf));
-    openvdb::CoordBBox region = bent->evalActiveVoxelBoundingBox();
-    region.expand(2);
     for (const Seeding way : {Seeding::Either, Seeding::Lower}) {
         GridPtr g = bent->deepCopy();
-        renormalize(*g, region, all, all, FmmOrder::Second, nullptr, way);
+        renormalizeAllMoved(*g, way);
         const Errors e = compare(*g, kBall);
         const bool either = way == Seeding::Either;
         std::printf("[ fmm ] a ball's values steepened along the normal, seeds %s: next to the "
@@ -802,15 +807,10 @@ TEST(FastMarching, AfterATearASecondPassSeedsFromTheSurface) {
         const double d = *it / h;
         it.setValue(float((d - 0.5 * d * d) * s * h));
     }
-    VoxelList all;
-    for (auto leaf = torn->tree().cbeginLeaf(); leaf; ++leaf)
-        all.push_back(activeVoxelsOf(*leaf));
-    openvdb::CoordBBox region = torn->evalActiveVoxelBoundingBox();
-    region.expand(2);
     GridPtr once = torn->deepCopy();
-    renormalize(*once, region, all, all, FmmOrder::Second, nullptr, Seeding::Either);
+    renormalizeAllMoved(*once, Seeding::Either);
     GridPtr twice = once->deepCopy();
-    renormalize(*twice, region, all, all, FmmOrder::Second, nullptr, Seeding::Interface);
+    renormalizeAllMoved(*twice, Seeding::Interface);
     const PeerCheck first = peerCheck(*once), second = peerCheck(*twice);
     const Errors e1 = compare(*once, kBall), e2 = compare(*twice, kBall);
     std::printf("[ fmm ] a ball steepened inside unevenly: refused %zu after the first pass, %zu "
