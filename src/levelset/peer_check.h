@@ -6,7 +6,8 @@
 // with a face neighbour across the surface, and refuses it outside [0.5, 1.5]. Its stencil
 // reads three voxels each way along each axis. Where the shape is thinner than that, a
 // distance field itself has a ridge (the shape's medial axis) or a second surface inside the
-// stencil, the one-sided differences read across it, and even the exact distance fails.
+// stencil, the one-sided differences read across it, and even the exact distance can fail (a
+// sheet two voxels thick does).
 // Such a voxel is on a thin feature when, along the normal through it, within three voxels
 // either way, the surface is crossed twice (a sheet or a gap thinner than that) or |phi|
 // stops growing away from the surface (a ridge of the distance: the medial axis of a part
