@@ -312,7 +312,8 @@ void exportMesh(const Grid& grid, const std::string& path, const std::string& up
 struct ApplyArgs {
     std::string script, output, mesh, up = "y";
     double voxelSize = 0.0;
-    bool perSubStep = false, firstOrder = false, stats = false, cubic = false, force = false;
+    bool perSubStep = false, firstOrder = false, stats = false, cubic = false, trilinear = false,
+         force = false;
 };
 
 int runApply(const ApplyArgs& a) {
@@ -325,7 +326,9 @@ int runApply(const ApplyArgs& a) {
     AdvectOptions options;
     options.resampleEachSubStep = a.perSubStep;
     options.renormalization = a.firstOrder ? FmmOrder::First : FmmOrder::Second;
-    options.sampling = a.cubic ? Sampling::MonotoneCubic : Sampling::Trilinear;
+    options.sampling = a.cubic       ? Sampling::MonotoneCubic
+                       : a.trilinear ? Sampling::Trilinear
+                                     : Sampling::Corrected;
     options.interrupter = &gStop;
     Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop, a.force),
                       options);
@@ -651,8 +654,13 @@ static int run(int argc, char** argv) {
     apply->add_flag("--resample-each-substep", applyArgs.perSubStep,
                     "Resample after every sub-step (the thesis's 5.3.4; blurrier)");
     apply->add_flag("--first-order", applyArgs.firstOrder, "First-order fast marching");
-    apply->add_flag("--monotone-cubic", applyArgs.cubic,
-                    "Resample with the monotone cubic of appendix C.1 instead of trilinear");
+    auto* cubic = apply->add_flag(
+        "--monotone-cubic", applyArgs.cubic,
+        "Resample with the monotone cubic of appendix C.1 instead of corrected trilinear");
+    apply
+        ->add_flag("--trilinear", applyArgs.trilinear,
+                   "Resample trilinearly without the correction (the thesis's 5.3.2)")
+        ->excludes(cubic);
     jsonFlag(apply, "what was measured and written");
     apply->add_flag("--force", applyArgs.force,
                     "Build the start shape even when it seems to need more memory than is free");

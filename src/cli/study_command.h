@@ -12,7 +12,7 @@ namespace sweepers::cli {
 
 struct StudyArgs {
     std::vector<std::string> scripts;
-    std::string dir, voxelSizes = "1/32,1/64,1/128,1/256", variants = "trilinear";
+    std::string dir, voxelSizes = "1/32,1/64,1/128,1/256", variants = "corrected";
     bool force = false;
     int jobs = 1;
     int* threads = nullptr; // the program's --threads (0: all cores)

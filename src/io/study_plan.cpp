@@ -37,13 +37,15 @@ constexpr double kRunBytesPerVoxel = 128.0;
 // What a run holds before it has a grid: the program, its libraries and thread stacks.
 constexpr double kRunBaseMb = 64.0;
 
-// Running time relative to trilinear: the cubic samples 64 values where trilinear takes 8;
-// resampling at every sub-step renormalizes as often.
+// Running time relative to the default engine: the cubic samples 64 values where the
+// corrected trilinear takes 32 near the surface and 8 elsewhere; resampling at every sub-step
+// renormalizes as often.
 double variantCost(StudyVariant v) {
     switch (v) {
     case StudyVariant::Cubic:
     case StudyVariant::PerSubStep:
         return 2.0;
+    case StudyVariant::Corrected:
     case StudyVariant::Trilinear:
     case StudyVariant::FirstOrder:
         break;
@@ -354,7 +356,7 @@ StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run, Interrupt
 void estimateStudyRuns(StudyPlan& plan, int threads) {
     for (std::size_t k = 0; k < plan.scripts.size(); ++k) {
         // The script's finished runs, one per voxel size (the first variant that finished
-        // there), their time as trilinear's.
+        // there), their time as the default engine's.
         struct Measured {
             StudyRow row;
             std::string id;

@@ -28,7 +28,7 @@ struct PlannedRun {
     std::string id;         // <script>-<variant>_<N>: also the name of its directory under runs/
     std::size_t script = 0; // in StudyPlan::scripts
     double voxelSize = 0.0;
-    StudyVariant variant = StudyVariant::Trilinear;
+    StudyVariant variant = StudyVariant::Corrected;
     std::string digest; // of what its result depends on
     // Estimates (0 where there is nothing yet to estimate from): peak resident memory, and
     // wall time at `threads` worker threads; `basis` says what they were scaled from.

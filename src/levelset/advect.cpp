@@ -12,6 +12,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <utility>
 #include <vector>
@@ -34,6 +35,10 @@ constexpr std::size_t kStretchSampling = 4;
 // within a voxel of the new surface along an axis, and its central differences read one more.
 constexpr int kSeedReach = 2;
 
+// The values a seed of renormalization has after sampling, in voxels: those of a crossing's
+// ends, but for a stretch that spreads them (there the gradient's own norm serves).
+constexpr double kSeedValues = 1.5;
+
 // How many interface voxels a thread maps through the sub-steps at once: enough for the
 // batched maps to pay, few enough for the points to stay in cache.
 constexpr std::size_t kMapBatch = 256;
@@ -46,6 +51,44 @@ float trilinearIn(const float (&c)[2][2][2], const openvdb::Vec3d& uvw) {
     const auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
     return lerp(lerp(lerp(c[0][0][0], c[0][0][1], w), lerp(c[0][1][0], c[0][1][1], w), v),
                 lerp(lerp(c[1][0][0], c[1][0][1], w), lerp(c[1][1][0], c[1][1][1], w), v), u);
+}
+
+// Sampling::Corrected at offset uvw in a cell: the trilinear value less half of each axis's
+// second differences, interpolated from the cell's corners like the values, times t (1 - t)
+// on that axis. `at(i, j, k)` reads the value at offset (i, j, k) from the cell's lowest
+// corner, each from -1 to 2 (the corners and one voxel beyond them along each axis). Within
+// `reach` of the surface, `slope` (when given) receives the central differences at the
+// corners, interpolated likewise: those of the trilinear values one voxel either way.
+template <typename At>
+float correctedIn(const At& at, const openvdb::Vec3d& uvw, float reach, float* slope = nullptr) {
+    float c[2][2][2];
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+            for (int k = 0; k < 2; ++k)
+                c[i][j][k] = at(i, j, k);
+    const float linear = trilinearIn(c, uvw);
+    if (!(std::abs(linear) < reach)) return linear;
+    float d1[3][2][2][2], d2[3][2][2][2];
+    for (int i = 0; i < 2; ++i)
+        for (int j = 0; j < 2; ++j)
+            for (int k = 0; k < 2; ++k) {
+                const int o = 1 - 2 * i, p = 1 - 2 * j, q = 1 - 2 * k; // into the cell
+                const float twice = 2.0f * c[i][j][k];
+                const float in[3] = {c[1 - i][j][k], c[i][1 - j][k], c[i][j][1 - k]};
+                const float out[3] = {at(i - o, j, k), at(i, j - p, k), at(i, j, k - q)};
+                const int into[3] = {o, p, q};
+                for (int a = 0; a < 3; ++a) {
+                    d1[a][i][j][k] = 0.5f * float(into[a]) * (in[a] - out[a]);
+                    d2[a][i][j][k] = in[a] - twice + out[a];
+                }
+            }
+    float correction = 0.0f;
+    for (int a = 0; a < 3; ++a) {
+        const float t = float(uvw[a]);
+        correction += t * (1.0f - t) * trilinearIn(d2[a], uvw);
+        if (slope) slope[a] = trilinearIn(d1[a], uvw);
+    }
+    return linear - 0.5f * correction;
 }
 
 // The cell (its lowest corner) holding index-space point p: the floor on each axis, as a
@@ -187,6 +230,14 @@ class SampleSource {
             return trilinearIn(data, uvw);
         }
 
+        // Sampling::Corrected at index-space point p (correctedIn), within `reach` (index
+        // units) of the surface.
+        float corrected(const openvdb::Vec3d& p, float reach, float* slope = nullptr) const {
+            const openvdb::Coord ijk = cellOf(p);
+            return correctedIn([&](int i, int j, int k) { return getValue(ijk.offsetBy(i, j, k)); },
+                               p - ijk.asVec3d(), reach, slope);
+        }
+
         // The source leaf holding ijk (a copy, or the live grid's), or null over a tile.
         const LeafNode* leafAt(const openvdb::Coord& ijk) const {
             if (const LeafNode* leaf = copy(ijk)) return leaf;
@@ -250,6 +301,25 @@ class SourceBlock {
         return trilinearIn(data, uvw);
     }
 
+    // The value at ijk, within kRim voxels of the leaf.
+    float at(const openvdb::Coord& ijk) const { return values_[index(ijk)]; }
+    // Whether the cell with lowest corner ijk and a voxel around it lie in the block.
+    bool holdsAround(const openvdb::Coord& ijk) const {
+        const openvdb::Coord d = ijk - min_;
+        return d.x() >= 1 && d.y() >= 1 && d.z() >= 1 && d.x() < kDim - 2 && d.y() < kDim - 2 &&
+               d.z() < kDim - 2;
+    }
+    // Sampling::Corrected in the cell with lowest corner ijk (held with a voxel around it).
+    float corrected(const openvdb::Coord& ijk, const openvdb::Vec3d& uvw, float reach,
+                    float* slope = nullptr) const {
+        const std::size_t o = index(ijk);
+        return correctedIn(
+            [&](int i, int j, int k) {
+                return values_[std::size_t(std::ptrdiff_t(o) + (i * kDim + j) * kDim + k)];
+            },
+            uvw, reach, slope);
+    }
+
   private:
     std::size_t index(const openvdb::Coord& ijk) const {
         const openvdb::Coord d = ijk - min_;
@@ -311,13 +381,16 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
                      const StepDeformation* tearing, double tornWindow, Sampling sampling,
                      Changes changes, Interrupter* interrupter, ResampleScratches& scratch,
-                     const openvdb::MaskTree* only = nullptr, Staged* staged = nullptr) {
+                     const openvdb::MaskTree* only = nullptr, Staged* staged = nullptr,
+                     VoxelValues* gradientBefore = nullptr) {
     // Per leaf, the voxels whose value changed and those that moved (a word per x, as the
     // leaf's mask holds them): written by the leaf's own task, then listed.
     std::vector<leafwords::Words> changedWords(leaves.size()), movedWords(leaves.size());
     std::atomic<std::size_t> count{0};
     const VoxelPlacement place(grid.transform());
     const bool windowPastRim = tearing && tearing->windowPastRim();
+    const double h = grid.voxelSize()[0];
+    const float reach = float(kCorrectedReach * h), seedReach = float(kSeedValues * h);
     parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
         const SampleSource::Accessor acc(source);
         ResampleScratch& s = scratch.local();
@@ -329,6 +402,11 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
             // The leaf as the source holds it (a copy where sampling writes this one), to tell
             // which voxels the band grew into.
             const LeafNode* before = acc.leafAt(leaf.origin());
+            if (gradientBefore) {
+                LeafValues& g = (*gradientBefore)[l];
+                g.origin = leaf.origin();
+                g.values.fill(std::numeric_limits<float>::quiet_NaN());
+            }
             // With `only`, just the active voxels it holds are sampled.
             const auto* wanted = only ? only->probeConstLeaf(leaf.origin()) : nullptr;
             if (only && !wanted) continue;
@@ -358,20 +436,25 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                 const Eigen::Vector3d& y = s.y[std::size_t(i)];
                 const float old = values[pos];
                 float v = old;
+                float slope[3] = {std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f};
                 if (y != x || !sourceIsGrid) {
-                    const auto sample = [&](const Eigen::Vector3d& at) {
+                    const auto sample = [&](const Eigen::Vector3d& at, float* slopeAt = nullptr) {
                         const openvdb::Vec3d p = place.toIndex(toVdb(at));
-                        if (sampling != Sampling::Trilinear)
+                        if (sampling == Sampling::MonotoneCubic)
                             return float(sampleMonotoneCubic(acc, p));
                         const openvdb::Coord cell = cellOf(p);
                         if (!filled) {
                             block.fill(acc, leaf.origin());
                             filled = true;
                         }
+                        if (sampling == Sampling::Corrected)
+                            return block.holdsAround(cell)
+                                       ? block.corrected(cell, p - cell.asVec3d(), reach, slopeAt)
+                                       : acc.corrected(p, reach, slopeAt);
                         return block.holds(cell) ? block.trilinear(cell, p - cell.asVec3d())
                                                  : acc.trilinear(p);
                     };
-                    v = sample(y);
+                    v = sample(y, gradientBefore ? slope : nullptr);
                     if (tearing) {
                         const double depth = tearing->openedDepth(x);
                         if (depth > 0.0 || (windowPastRim && depth > -tornWindow)) {
@@ -388,6 +471,26 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                         v = std::max(v, float(tearing->leastValue(y))) +
                             float(std::max(0.0, depth));
                     }
+                }
+                if (gradientBefore && std::abs(v) < seedReach) {
+                    // The source's central differences at the pre-image (renormalize()): from
+                    // the sample's own reads, or, for a voxel that kept its value, its
+                    // neighbours'.
+                    if (std::isnan(slope[0])) {
+                        if (!filled) {
+                            block.fill(acc, leaf.origin());
+                            filled = true;
+                        }
+                        const openvdb::Coord c = leaf.offsetToGlobalCoord(openvdb::Index(pos));
+                        for (int a = 0; a < 3; ++a) {
+                            openvdb::Coord e(0);
+                            e[a] = 1;
+                            slope[a] = 0.5f * (block.at(c + e) - block.at(c - e));
+                        }
+                    }
+                    const float norm =
+                        std::sqrt(slope[0] * slope[0] + slope[1] * slope[1] + slope[2] * slope[2]);
+                    (*gradientBefore)[l].values[std::size_t(pos)] = norm / float(h);
                 }
                 const bool joined =
                     !(before ? before->isValueOn(openvdb::Index(pos))
@@ -658,6 +761,10 @@ struct SegmentAdvector::Work {
     int bandReach = 0, reach = 0;
     VoxelList images, mask, fresh, changed, moved, freed;
     GridPtr widened; // the copies with the widened band, when it had to be widened
+    // Per moving leaf, the gradient norms its seeds had before the segment
+    // (Sampling::Corrected, but for tears).
+    VoxelValues gradientBefore;
+    bool dividesByStretch = false;
     std::vector<LeafNode*> sampled, moving;
 
     // Gives a kept buffer room for n entries, counting when its storage has to grow. A
@@ -692,6 +799,7 @@ struct SegmentAdvector::Work {
             list->clear();
         sampled.clear();
         moving.clear();
+        dividesByStretch = false;
     }
 
     // Leaves where the deformation is the identity (within a voxel of them: the stretch
@@ -1068,14 +1176,18 @@ void SegmentAdvector::Work::sample() {
     }
     const auto map = [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y,
                          MapScratch& scratch) { seg->inverseMaps(x, n, y, scratch); };
+    // A tear's seeds are estimated otherwise (renormalizeChanged).
+    dividesByStretch = options->sampling == Sampling::Corrected && !tearing;
+    if (dividesByStretch) fit(gradientBefore, moving.size());
     // Sampling reads the grid itself and writes beside it (staged), or, from a widened band,
     // reads the copies that hold it and writes into the grid.
     const auto from =
         widened ? std::make_shared<SampleSource>(*grid, widened) : SampleSource::live(*grid);
     if (!widened) staged.reserve(moving.size(), growths);
-    stats.sampledVoxels = resample(*grid, moving, *from, !widened, region, map, tearing, tornWindow,
-                                   options->sampling, changes(), options->interrupter, resampling,
-                                   nullptr, widened ? nullptr : &staged);
+    stats.sampledVoxels =
+        resample(*grid, moving, *from, !widened, region, map, tearing, tornWindow,
+                 options->sampling, changes(), options->interrupter, resampling, nullptr,
+                 widened ? nullptr : &staged, dividesByStretch ? &gradientBefore : nullptr);
     if (!widened) {
         staged.swapInto(moving);
         stats.leavesCopied += moving.size();
@@ -1143,7 +1255,8 @@ void SegmentAdvector::Work::renormalizeChanged() {
     moved.insert(moved.end(), fresh.begin(), fresh.end());
     const auto pass = [&](Seeding seeding) {
         const FmmStats fmm = renormalize(*grid, touched, freed, moved, options->renormalization,
-                                         options->interrupter, seeding);
+                                         options->interrupter, seeding,
+                                         dividesByStretch ? &gradientBefore : nullptr);
         stats.leavesVisited += fmm.leaves;
         stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
     };

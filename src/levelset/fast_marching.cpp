@@ -380,13 +380,19 @@ constexpr int kMostSweeps = 32, kMostRounds = 100;
 class Renormalizer {
   public:
     Renormalizer(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
-                 const VoxelList* moved, FmmOrder order, Interrupter* interrupter, Seeding seeding)
+                 const VoxelList* moved, FmmOrder order, Interrupter* interrupter, Seeding seeding,
+                 const VoxelValues* gradientBefore)
         : b_(grid, region, 2, only), n_(b_.size()), h_(float(grid.voxelSize()[0])),
-          bg_(grid.background()), order_(order), seeding_(seeding), interrupter_(interrupter),
+          bg_(grid.background()), order_(order), seeding_(seeding),
+          gradientBefore_(b_.leafCount(), nullptr), interrupter_(interrupter),
           phi_(b_.leafCount(), nullptr), dist_(new float[n_]), thin_(b_.leafCount(), Bits{}),
           neg_(new Bits[b_.leafCount()]), fixed_(new Bits[b_.leafCount()]),
           settled_(new Bits[b_.leafCount()]), beyond_(new Bits[b_.leafCount()]),
           layout_(b_.leafCount(), 2) {
+        if (gradientBefore)
+            for (const LeafValues& leaf : *gradientBefore)
+                if (const int l = b_.indexOf(leaf.origin); l >= 0)
+                    gradientBefore_[std::size_t(l)] = leaf.values.data();
         // Voxels outside the region (or outside `only`) are boundary: they keep their values.
         std::vector<Bits> freeOf(b_.leafCount()); // per leaf, its free voxels
         std::vector<Bits> within;                 // per leaf, the voxels of `only`
@@ -603,6 +609,14 @@ class Renormalizer {
                            seeding_ == Seeding::Interface ? linearSurfaceDistance(i, face) : kInf;
                        s < kInf) {
                 d = s; // no farther than the nearest crossing: the surface passes through it
+            } else if (const float before = gradientBefore(i);
+                       before > 0.0f && grad2 > 1e-12 * double(h) * h) {
+                // The stretch the deformation made here: the value is a distance divided by it
+                // where the values were one before (a seed's, or the upwind solution's).
+                const double stretch = std::sqrt(grad2) / h / before;
+                d = std::abs(stretch - 1.0) < kUnitSlack
+                        ? std::abs(p)
+                        : std::min(float(std::abs(p) / stretch), nearestCrossing * h);
             } else if (grad2 > 1e-12 * double(h) * h) {
                 const double gradNorm = std::sqrt(grad2) / h;
                 // A value whose gradient is already unit within kUnitSlack is a distance: kept,
@@ -648,6 +662,13 @@ class Renormalizer {
             count.local() += n;
         });
         return count.combine(std::plus<>());
+    }
+
+    // The gradient's norm voxel i's value had before the deformation (renormalize()), or 0
+    // where none was given.
+    float gradientBefore(std::size_t i) const {
+        const float* values = gradientBefore_[i >> 9];
+        return values && seeding_ == Seeding::Lower ? values[i & 511] : 0.0f;
     }
 
     // The distance to the linear surface through the crossings of the 3x3x3 block around
@@ -1119,6 +1140,9 @@ class Renormalizer {
     const float h_, bg_;
     const FmmOrder order_;
     const Seeding seeding_;
+    // Per leaf: the gradient norms its values had before the deformation (renormalize()), or
+    // null.
+    std::vector<const float*> gradientBefore_;
     Interrupter* const interrupter_;
     // Per leaf: its values (the grid's, as they were sampled).
     std::vector<const float*> phi_;
@@ -1147,10 +1171,12 @@ class Renormalizer {
 
 FmmStats renormalizeWhere(Grid& grid, const openvdb::CoordBBox& region, const VoxelList* only,
                           const VoxelList* moved, FmmOrder order, Interrupter* interrupter,
-                          Seeding seeding = Seeding::Lower) {
+                          Seeding seeding = Seeding::Lower,
+                          const VoxelValues* gradientBefore = nullptr) {
     if (region.empty()) return {};
     pollInterrupt(interrupter);
-    Renormalizer renormalizer(grid, region, only, moved, order, interrupter, seeding);
+    Renormalizer renormalizer(grid, region, only, moved, order, interrupter, seeding,
+                              gradientBefore);
     return renormalizer.run(grid);
 }
 
@@ -1168,8 +1194,9 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelLi
 
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      const VoxelList& moved, FmmOrder order, Interrupter* interrupter,
-                     Seeding seeding) {
-    return renormalizeWhere(grid, region, &only, &moved, order, interrupter, seeding);
+                     Seeding seeding, const VoxelValues* gradientBefore) {
+    return renormalizeWhere(grid, region, &only, &moved, order, interrupter, seeding,
+                            gradientBefore);
 }
 
 FmmStats renormalizeAll(Grid& grid, FmmOrder order, Interrupter* interrupter) {

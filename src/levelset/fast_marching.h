@@ -77,9 +77,18 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelLi
 // (advection leaves out changes of less than a hundredth of a voxel): seeds are recomputed
 // only where their stencil (the voxel and its face neighbours) holds a voxel of `moved`;
 // other seeds keep their values, as boundary.
+//
+// With `gradientBefore` (Seeding::Lower only), a seed for which it holds a value is its
+// value divided by the stretch the deformation made there: its gradient's norm (central
+// differences) over the norm the values had before, at its pre-image. Central differences
+// read a distance's gradient below 1 wherever the surface curves within a few voxels, so a
+// seed divided by its own gradient's norm grows each time it is seeded again: the surface
+// sharpens what curves, which trilinear sampling's rounding roughly cancels, but which
+// creeps under a sampling that does not round (advect.h, Sampling::Corrected).
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      const VoxelList& moved, FmmOrder order = FmmOrder::Second,
-                     Interrupter* interrupter = nullptr, Seeding seeding = Seeding::Lower);
+                     Interrupter* interrupter = nullptr, Seeding seeding = Seeding::Lower,
+                     const VoxelValues* gradientBefore = nullptr);
 // Renormalizes the whole active band.
 FmmStats renormalizeAll(Grid& grid, FmmOrder order = FmmOrder::Second,
                         Interrupter* interrupter = nullptr);

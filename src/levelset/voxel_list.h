@@ -4,6 +4,7 @@
 // their thousands of leaves was made and freed on its own.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include <openvdb/math/Coord.h>
@@ -17,5 +18,13 @@ struct LeafVoxels {
     leafwords::Words words;
 };
 using VoxelList = std::vector<LeafVoxels>;
+
+// A value for voxels of some leaves, listed leaf by leaf (each leaf once): NaN where a voxel
+// has none.
+struct LeafValues {
+    openvdb::Coord origin;
+    std::array<float, 512> values;
+};
+using VoxelValues = std::vector<LeafValues>;
 
 } // namespace sweepers

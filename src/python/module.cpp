@@ -402,8 +402,9 @@ py::object study(const py::object& scripts, const py::object& voxelSizes,
                                                                 : py::list(variants)) {
         const auto kind = parseVariant(v.cast<std::string>());
         if (!kind)
-            throw std::invalid_argument("variants: unknown variant '" + v.cast<std::string>() +
-                                        "' (trilinear, cubic, per-substep, first-order)");
+            throw std::invalid_argument(
+                "variants: unknown variant '" + v.cast<std::string>() +
+                "' (corrected, trilinear, cubic, per-substep, first-order)");
         kinds.push_back(*kind);
     }
     if (paths.empty() || sizes.empty() || kinds.empty())
@@ -564,10 +565,10 @@ PYBIND11_MODULE(sweepers, m) {
     addShapeMethods(sculptor, [](const Session& s) { return s.view(); });
 
     m.def("study", &study, py::arg("scripts"), py::arg("voxel_sizes"),
-          py::arg("variants") = py::make_tuple("trilinear"), py::arg("directory") = py::none(),
+          py::arg("variants") = py::make_tuple("corrected"), py::arg("directory") = py::none(),
           py::arg("force") = false, py::arg("progress") = py::none(),
           "Runs a grid-resolution study (docs/studies.md) of one or more scripts at each voxel "
-          "size (numbers or '1/N') and variant ('trilinear', 'cubic', 'per-substep', "
+          "size (numbers or '1/N') and variant ('corrected', 'trilinear', 'cubic', 'per-substep', "
           "'first-order') and returns its rows, keyed by the columns of study.csv: a pandas "
           "DataFrame when pandas is installed, else a list of dicts. In `directory` (kept, and "
           "resumed from) or a temporary one. `progress` sees runs done and in all.");

@@ -63,6 +63,6 @@ class Sculptor:
 
 def study(scripts: Union[PathLike, Sequence[PathLike]],
           voxel_sizes: Sequence[Union[float, str]],
-          variants: Union[str, Sequence[str]] = ("trilinear",),
+          variants: Union[str, Sequence[str]] = ("corrected",),
           directory: Optional[PathLike] = None, force: bool = False,
           progress: Progress = None) -> Union["pandas.DataFrame", List[Dict[str, Any]]]: ...

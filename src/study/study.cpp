@@ -41,6 +41,8 @@ struct Tally {
 
 std::string variantName(StudyVariant v) {
     switch (v) {
+    case StudyVariant::Corrected:
+        return "corrected";
     case StudyVariant::Trilinear:
         return "trilinear";
     case StudyVariant::Cubic:
@@ -54,15 +56,17 @@ std::string variantName(StudyVariant v) {
 }
 
 std::optional<StudyVariant> parseVariant(const std::string& name) {
-    for (StudyVariant v : {StudyVariant::Trilinear, StudyVariant::Cubic, StudyVariant::PerSubStep,
-                           StudyVariant::FirstOrder})
+    for (StudyVariant v : {StudyVariant::Corrected, StudyVariant::Trilinear, StudyVariant::Cubic,
+                           StudyVariant::PerSubStep, StudyVariant::FirstOrder})
         if (variantName(v) == name) return v;
     return std::nullopt;
 }
 
 AdvectOptions variantOptions(StudyVariant v) {
     AdvectOptions o;
-    o.sampling = v == StudyVariant::Cubic ? Sampling::MonotoneCubic : Sampling::Trilinear;
+    o.sampling = v == StudyVariant::Cubic       ? Sampling::MonotoneCubic
+                 : v == StudyVariant::Trilinear ? Sampling::Trilinear
+                                                : Sampling::Corrected;
     o.resampleEachSubStep = v == StudyVariant::PerSubStep;
     o.renormalization = v == StudyVariant::FirstOrder ? FmmOrder::First : FmmOrder::Second;
     return o;

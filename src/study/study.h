@@ -16,14 +16,15 @@
 
 namespace sweepers {
 
-enum class StudyVariant { Trilinear, Cubic, PerSubStep, FirstOrder };
+enum class StudyVariant { Corrected, Trilinear, Cubic, PerSubStep, FirstOrder };
 
-// trilinear, cubic, per-substep, first-order.
+// corrected, trilinear, cubic, per-substep, first-order.
 std::string variantName(StudyVariant v);
 std::optional<StudyVariant> parseVariant(const std::string& name);
-// The engine's options for a variant: trilinear sampling of the composed inverse with
-// second-order fast marching, the monotone cubic of appendix C.1, one resample per sub-step
-// (5.3.4), or first-order fast marching.
+// The engine's options for a variant: the default engine (corrected trilinear sampling of
+// the composed inverse, second-order fast marching), plain trilinear sampling (the thesis's
+// 5.3.2), the monotone cubic of appendix C.1, one resample per sub-step (5.3.4), or
+// first-order fast marching.
 AdvectOptions variantOptions(StudyVariant v);
 
 // Distances between the result's surface and the reference's, both ways: from every vertex

@@ -88,7 +88,7 @@ json_keys "$tmp/study.json" script dir csv report runs reused failed files
 import csv, json, sys
 j = json.load(open(sys.argv[1]))
 rows = list(csv.DictReader(open(j["csv"])))
-assert [r["variant"] for r in j["runs"]] == [r["variant"] for r in rows] == ["trilinear"] * 2
+assert [r["variant"] for r in j["runs"]] == [r["variant"] for r in rows] == ["corrected"] * 2
 for r, c in zip(j["runs"], rows):
     assert set(r) == set(c), set(r) ^ set(c)  # the CSV's columns, no more, no fewer
     assert r["err_rms"] == float(c["err_rms"]) and r["genus"] == int(c["genus"]) == 0, (r, c)
@@ -153,10 +153,10 @@ JSON
 rc=0
 "$cli" study "$tmp/own.json" -o "$tmp/partly" --voxel-sizes 0.125,0.0625 2>"$tmp/partly.err" || rc=$?
 [ "$rc" = 3 ] || fail "a study with a failed run exited $rc: $(cat "$tmp/partly.err")"
-grep -q 'sweepers-cli: 1 of 2 runs failed (own-trilinear_8)' "$tmp/partly.err" ||
+grep -q 'sweepers-cli: 1 of 2 runs failed (own-corrected_8)' "$tmp/partly.err" ||
   fail "the failed run is not named: $(cat "$tmp/partly.err")"
-[ -s "$tmp/partly/runs/own-trilinear_16/grid.vdb" ] || fail "the run that could run was not written"
-grep -q '| trilinear | 1/8 | failed: ' "$tmp/partly/report.md" ||
+[ -s "$tmp/partly/runs/own-corrected_16/grid.vdb" ] || fail "the run that could run was not written"
+grep -q '| corrected | 1/8 | failed: ' "$tmp/partly/report.md" ||
   fail "report.md does not name the failed run"
 echo "exit codes: 0, 1, 2, 3 (a study with a failed run) and 130 (SIGINT)"
 echo "output: all checks passed"

@@ -77,11 +77,11 @@ rc=0
 "$cli" study "$tmp/own.json" -o "$tmp/failing" --voxel-sizes 1/8,1/16 --slurm --wait \
   2>"$tmp/err" || rc=$?
 [ "$rc" = 3 ] || fail "a study with a failed run exited $rc: $(cat "$tmp/err")"
-grep -q "sweepers-cli: 1 of 2 runs failed (own-trilinear_8)" "$tmp/err" ||
+grep -q "sweepers-cli: 1 of 2 runs failed (own-corrected_8)" "$tmp/err" ||
   fail "the failed run is not named: $(cat "$tmp/err")"
-grep -q "| trilinear | 1/8 | failed: " "$tmp/failing/report.md" ||
+grep -q "| corrected | 1/8 | failed: " "$tmp/failing/report.md" ||
   fail "report.md does not name the failed run"
-grep -q "| trilinear | 1/16 | " "$tmp/failing/report.md" || fail "the other run was not merged"
+grep -q "| corrected | 1/16 | " "$tmp/failing/report.md" || fail "the other run was not merged"
 echo "a failed run: exit 3, named; the other merged"
 
 # --- a task cancelled mid-run; a second submission refused; submitting again ------------
@@ -89,7 +89,7 @@ long=(--voxel-sizes 1/16,1/96)
 "$cli" study "$data/twisted_limb.json" -o "$tmp/cancel" "${long[@]}" --slurm -q >"$tmp/ids"
 array=$(awk '/^arrays/ {print $2}' "$tmp/ids")
 merge=$(awk '/^merge/ {print $2}' "$tmp/ids")
-run=twisted_limb-trilinear_96
+run=twisted_limb-corrected_96
 rc=0
 "$cli" study "$data/twisted_limb.json" -o "$tmp/cancel" "${long[@]}" --slurm 2>"$tmp/err" || rc=$?
 [ "$rc" = 1 ] && grep -q "still queued or running" "$tmp/err" ||

@@ -101,11 +101,11 @@ import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
 errs = [float(r["err_rms"]) for r in rows]
 orders = [float(r["order_rms"]) for r in rows[1:]]
-print("rigid motion, trilinear: err_rms", errs, "orders", orders)
+print("rigid motion, corrected: err_rms", errs, "orders", orders)
 assert errs[0] > errs[1] > errs[2], errs
 assert all(p >= 1.0 for p in orders), orders
 PY
-grep -q "| trilinear | 1/64 |" "$tmp/rigid/report.md" || fail "report.md lacks the 1/64 row"
+grep -q "| corrected | 1/64 |" "$tmp/rigid/report.md" || fail "report.md lacks the 1/64 row"
 "$py" - "$tmp/rigid" <<'PY'
 import sys, xml.etree.ElementTree as ET
 from PIL import Image
@@ -172,11 +172,11 @@ cp "$tmp/translate.json" "$tmp/edited.json"
 "$cli" study "$tmp/edited.json" -o "$tmp/edit" --voxel-sizes 1/16 --plan-only -q
 sed -i 's/0.2, 0.1, 0/0.25, 0.1, 0/' "$tmp/edited.json"
 rc=0
-"$cli" study -o "$tmp/edit" --run edited-trilinear_16 2>"$tmp/err" || rc=$?
+"$cli" study -o "$tmp/edit" --run edited-corrected_16 2>"$tmp/err" || rc=$?
 [ "$rc" = 1 ] && grep -q "changed since the study was planned" "$tmp/err" ||
   fail "an edited script ran: $rc $(cat "$tmp/err")"
 # A plan whose run id would name a directory elsewhere is refused, not followed.
-sed -i 's#"id": "edited-trilinear_16"#"id": "../../outside"#' "$tmp/edit/plan.json"
+sed -i 's#"id": "edited-corrected_16"#"id": "../../outside"#' "$tmp/edit/plan.json"
 rc=0
 "$cli" study -o "$tmp/edit" --list 2>"$tmp/err" || rc=$?
 [ "$rc" = 1 ] && grep -q "is not one of a study" "$tmp/err" ||
@@ -188,7 +188,7 @@ stopped KILL "$tmp/killed.err" '[ -f "$tmp/killed/study.csv" ] && [ "$(wc -l <"$
   study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/64 -q
 done_rows=$(($(wc -l <"$tmp/killed/study.csv") - 1))
 [ "$done_rows" -ge 2 ] || fail "the study wrote $done_rows rows before it was killed"
-stamp() { stat -c %y "$tmp/killed/runs/rigid_motion-trilinear_16/grid.vdb" "$tmp/killed/runs/rigid_motion-trilinear_32/grid.vdb"; }
+stamp() { stat -c %y "$tmp/killed/runs/rigid_motion-corrected_16/grid.vdb" "$tmp/killed/runs/rigid_motion-corrected_32/grid.vdb"; }
 before=$(stamp)
 "$cli" study "$data/studies/rigid_motion.json" -o "$tmp/killed" --voxel-sizes 1/16,1/32,1/64 \
   2>"$tmp/err"
@@ -218,7 +218,7 @@ refuses "sweepers-cli: --voxel-sizes: 'fine' is not a voxel size (a decimal such
   study "$s" -o "$tmp/bad" --voxel-sizes 1/32,fine
 refuses "sweepers-cli: a sphere of radius 0.5 at voxel size 1e-09 is 5e+08 voxels in radius; use 1.5 to 100000" \
   study "$s" -o "$tmp/bad" --voxel-sizes 1e-9
-refuses "sweepers-cli: --variants: unknown variant 'quintic' (trilinear, cubic, per-substep, first-order)" \
+refuses "sweepers-cli: --variants: unknown variant 'quintic' (corrected, trilinear, cubic, per-substep, first-order)" \
   study "$s" -o "$tmp/bad" --variants trilinear,quintic
 [ ! -e "$tmp/bad" ] || fail "a refused study left $tmp/bad"
 touch "$tmp/file"

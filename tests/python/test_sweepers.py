@@ -391,7 +391,7 @@ def test_a_study_gives_the_clis_table(tmp_path):
         assert float(row["err_rms"]) == pytest.approx(frame["err_rms"], rel=1e-6)
         assert int(row["active_voxels"]) == frame["active_voxels"]
     # Without a directory: a temporary one, removed.
-    again = sweepers.study(RIGID, [1 / 16])
+    again = sweepers.study(RIGID, [1 / 16], "trilinear")
     assert list(again["err_rms"]) == [rows["err_rms"][0]]
 
 

@@ -821,3 +821,88 @@ TEST(FastMarching, AfterATearASecondPassSeedsFromTheSurface) {
     EXPECT_EQ(e2.signFlips, 0u);
     EXPECT_LE(e2.rmsNear, e1.rmsNear);
 }
+
+namespace {
+
+// Per leaf of g, each active voxel's gradient norm by central differences (NaN elsewhere).
+VoxelValues gradientNorms(const Grid& g) {
+    const double h = g.voxelSize()[0];
+    auto acc = g.getConstAccessor();
+    VoxelValues norms;
+    for (auto leaf = g.tree().cbeginLeaf(); leaf; ++leaf) {
+        LeafValues& out = norms.emplace_back();
+        out.origin = leaf->origin();
+        out.values.fill(std::numeric_limits<float>::quiet_NaN());
+        for (auto it = leaf->cbeginValueOn(); it; ++it) {
+            double g2 = 0.0;
+            for (int a = 0; a < 3; ++a) {
+                openvdb::Coord e(0);
+                e[a] = 1;
+                const double d =
+                    0.5 * (acc.getValue(it.getCoord() + e) - acc.getValue(it.getCoord() - e));
+                g2 += d * d;
+            }
+            out.values[it.pos()] = float(std::sqrt(g2) / h);
+        }
+    }
+    return norms;
+}
+
+} // namespace
+
+// Central differences read a distance's gradient below 1 where the surface curves within a
+// few voxels, so a seed divided by its own gradient's norm grows each time it is seeded
+// again. A ball three voxels in radius (its exact distance) seeded again eight times, every
+// voxel counted as moved: divided by their own gradient's norm, its seeds creep; divided by
+// the stretch (the norms the values had before: the same field, a stretch of 1) they keep
+// their values to the bit. The same ball's values doubled (a stretch of 2, the norms before
+// the ball's) come back to its distance.
+TEST(FastMarching, SeedsDividedByTheStretchDoNotCreep) {
+    const double h = 1.0 / 32, radius = 3 * h;
+    const auto ball = [&](const Eigen::Vector3d& p) { return p.norm() - radius; };
+    const GridPtr exact = gridFromSdf(ball, h, 3, openvdb::CoordBBox::createCube({-8, -8, -8}, 16));
+    const VoxelValues before = gradientNorms(*exact);
+    VoxelList all;
+    for (auto leaf = exact->tree().cbeginLeaf(); leaf; ++leaf)
+        all.push_back(activeVoxelsOf(*leaf));
+    openvdb::CoordBBox region = exact->evalActiveVoxelBoundingBox();
+    region.expand(2);
+    // Seeded again `times` times; `byStretch`: with the norms the values had before each
+    // time (those of `before` the first time, of the grid itself after).
+    const auto seeded = [&](const Grid& start, bool byStretch, int times) {
+        GridPtr g = start.deepCopy();
+        for (int k = 0; k < times; ++k) {
+            const VoxelValues norms = k == 0 ? before : gradientNorms(*g);
+            renormalize(*g, region, all, all, FmmOrder::Second, nullptr, Seeding::Lower,
+                        byStretch ? &norms : nullptr);
+        }
+        return g;
+    };
+    // The largest change of a seed (a voxel next to the crossing), in voxels.
+    const auto seedsMoved = [&](const Grid& g) {
+        auto was = exact->getConstAccessor(), now = g.getConstAccessor();
+        double most = 0.0;
+        std::size_t seeds = 0;
+        for (auto leaf = exact->tree().cbeginLeaf(); leaf; ++leaf)
+            for (auto it = leaf->cbeginValueOn(); it; ++it)
+                if (nextToCrossing(*leaf, it.pos(), was)) {
+                    ++seeds;
+                    most = std::max(most, std::abs(now.getValue(it.getCoord()) - *it) / h);
+                }
+        EXPECT_GT(seeds, 100u);
+        return most;
+    };
+    const double own = seedsMoved(*seeded(*exact, false, 8));
+    const double stretch = seedsMoved(*seeded(*exact, true, 8));
+    GridPtr doubled = exact->deepCopy();
+    for (auto it = doubled->beginValueOn(); it; ++it)
+        it.setValue(2.0f * *it);
+    const double back = seedsMoved(*seeded(*doubled, true, 1));
+    std::printf("[ fmm ] a ball 3 voxels in radius seeded 8 times: seeds moved by %.3f voxel "
+                "divided by their gradient's norm, %.3f by the stretch; its values doubled "
+                "come back within %.2g voxel\n",
+                own, stretch, back);
+    EXPECT_GT(own, 0.05);
+    EXPECT_EQ(stretch, 0.0);
+    EXPECT_LT(back, 1e-4);
+}

@@ -75,18 +75,18 @@ struct Unexplained {
     std::size_t fine, coarse;
 };
 const std::map<std::string, Unexplained> kUnexplained = {
-    {"drag", {0, 9}},
-    {"finger", {0, 26}},
-    {"horn", {0, 0}},
-    {"mirrored_ears", {0, 4}},
-    {"pinch", {0, 27}},
-    {"pinch_torus", {104, 0}},
+    {"drag", {0, 0}},
+    {"finger", {0, 20}},
+    {"horn", {0, 2}},
+    {"mirrored_ears", {0, 8}},
+    {"pinch", {0, 0}},
+    {"pinch_torus", {52, 0}},
     {"pull", {0, 0}},
-    {"severed_horn", {14, 36}},
+    {"severed_horn", {12, 36}},
     {"starfish_swirls", {0, 0}},
-    {"strangle_torus", {140, 113}},
-    {"twisted_limb", {2, 2}},
-    {"two_handles", {46, 151}},
+    {"strangle_torus", {125, 137}},
+    {"twisted_limb", {0, 2}},
+    {"two_handles", {14, 112}},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
