@@ -78,7 +78,7 @@ float correctedIn(const At& at, const openvdb::Vec3d& uvw, float reach, float* s
                 const float out[3] = {at(i - o, j, k), at(i, j - p, k), at(i, j, k - q)};
                 const int into[3] = {o, p, q};
                 for (int a = 0; a < 3; ++a) {
-                    d1[a][i][j][k] = 0.5f * float(into[a]) * (in[a] - out[a]);
+                    if (slope) d1[a][i][j][k] = 0.5f * float(into[a]) * (in[a] - out[a]);
                     d2[a][i][j][k] = in[a] - twice + out[a];
                 }
             }
@@ -271,9 +271,11 @@ void SampleSource::copyAlso(const std::vector<LeafNode*>& leaves, const Staged& 
 // The source values around one leaf, in a dense block: a leaf's pre-images of a drag lie
 // within a voxel or two of it, and their trilinear samples read the block by strides,
 // where each of them took a tree lookup, and eight where the cell crosses a leaf border.
+// Corrected samples read a voxel more around their cell: the rim of three voxels holds
+// those of pre-images up to two voxels out, as trilinear samples' were with two.
 class SourceBlock {
   public:
-    static constexpr int kRim = 2, kDim = int(LeafNode::DIM) + 2 * kRim;
+    static constexpr int kRim = 3, kDim = int(LeafNode::DIM) + 2 * kRim;
 
     // Fills the block around the leaf at `origin` from the source.
     void fill(const SampleSource::Accessor& acc, const openvdb::Coord& origin) {
