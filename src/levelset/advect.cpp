@@ -317,7 +317,8 @@ class SourceBlock {
         const std::size_t o = index(ijk);
         return correctedIn(
             [&](int i, int j, int k) {
-                return values_[std::size_t(std::ptrdiff_t(o) + (i * kDim + j) * kDim + k)];
+                const std::ptrdiff_t step = (std::ptrdiff_t(i) * kDim + j) * kDim + k;
+                return values_[std::size_t(std::ptrdiff_t(o) + step)];
             },
             uvw, reach, slope);
     }

@@ -7,11 +7,13 @@
 //     root of the second-order model of phi along the normal where that lies more than a
 //     twentieth of a voxel lower (the field bends within the voxel; after a tear, lower or
 //     higher), or, in a second pass after a tear, the distance to the surface the values
-//     place (Seeding). Values whose gradient is already unit within 1%, and values on or
-//     within two voxels of a feature one voxel thin (but for that cap), are kept, and so are
-//     seeds whose stencil a deformation did not change (the `moved` overload): the estimate
-//     is not idempotent where the surface curves within a voxel, and an interface seeded
-//     again and again would creep. The sign of every voxel is kept.
+//     place (Seeding); given the gradient norms the values had before a deformation, phi
+//     over the stretch it made instead (renormalize()). Values whose gradient (or stretch) is
+//     already unit within 1%, and values on or within two voxels of a feature one voxel thin
+//     (but for that cap), are kept, and so are seeds whose stencil a deformation did not
+//     change (the `moved` overload): the estimate is not idempotent where the surface
+//     curves within a voxel, and an interface seeded again and again would creep. The sign
+//     of every voxel is kept.
 //  2. every other voxel gets the upwind solution from its neighbours of its own side: the
 //     first-order stencil, or the second-order one (HAFMM) where the voxel beyond the upwind
 //     neighbour is closer still. These are solved leaf by leaf, the leaves of one parity
