@@ -17,4 +17,4 @@ def test_the_walk_through_runs(monkeypatch):
     assert len(scope["s"].script()["strokes"]) == 3
     assert scope["vertices"].shape[1] == 3
     assert os.path.getsize(os.path.join(scope["work"], "convergence.png")) > 10000
-    assert set(scope["rows"]["variant"]) == {"trilinear", "cubic"}
+    assert set(scope["rows"]["variant"]) == {"corrected", "trilinear"}
