@@ -31,8 +31,8 @@ namespace sweepers {
 
 // How sampling reads the grid between its voxels.
 //  Trilinear: the thesis's (5.3.2). Its error is half the second differences times
-//    t (1 - t) along each axis: it reads a distance that curves high outside a convex surface
-//    and inside a concave one, and rounds the shape off a little at every segment.
+//    t (1 - t) along each axis: it reads a distance high next to a convex surface (inside
+//    and out) and low next to a concave one, and rounds the shape off at every segment.
 //  Corrected: trilinear less that term, with the second differences of the cell's corners
 //    interpolated, where the value lies within kCorrectedReach voxels of the surface (farther
 //    out the differences read the band's clamp): it reads every quadratic field exactly. Its

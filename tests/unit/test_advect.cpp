@@ -262,7 +262,7 @@ TEST(Advect, ASecondSamplingPassReadsTheGridAsItWas) {
 }
 
 // Trilinear sampling's error is half the second differences times t (1 - t) along each
-// axis: it reads a distance high outside a convex surface and low inside, and rounds the
+// axis: it reads a distance high next to a convex surface, inside and out, and rounds the
 // shape off. Corrected sampling takes that term off. A ball 6 voxels in radius moved by 20
 // voxels, sampled only (not renormalized), next to its surface: trilinear reads it high (the
 // ball shrinks), and the corrected values lie within a two-hundredth of a voxel of its
