@@ -35,6 +35,10 @@ constexpr std::size_t kStretchSampling = 4;
 // within a voxel of the new surface along an axis, and its central differences read one more.
 constexpr int kSeedReach = 2;
 
+// How far from the surface (in voxels) Sampling::Corrected corrects: farther out, the second
+// differences read the band's clamp.
+constexpr double kCorrectedReach = 2.5;
+
 // The values a seed of renormalization has after sampling, in voxels: those of a crossing's
 // ends, but for a stretch that spreads them (there the gradient's own norm serves).
 constexpr double kSeedValues = 1.5;
@@ -767,7 +771,6 @@ struct SegmentAdvector::Work {
     // Per moving leaf, the gradient norms its seeds had before the segment
     // (Sampling::Corrected, but for tears).
     VoxelValues gradientBefore;
-    bool dividesByStretch = false;
     std::vector<LeafNode*> sampled, moving;
 
     // Gives a kept buffer room for n entries, counting when its storage has to grow. A
@@ -802,7 +805,13 @@ struct SegmentAdvector::Work {
             list->clear();
         sampled.clear();
         moving.clear();
-        dividesByStretch = false;
+    }
+
+    // Whether renormalization divides this segment's seeds by its stretch: with corrected
+    // sampling of the composed inverse, but for a tear (renormalizeChanged).
+    bool dividesByStretch() const {
+        return options->sampling == Sampling::Corrected && !options->resampleEachSubStep &&
+               !seg->tears();
     }
 
     // Leaves where the deformation is the identity (within a voxel of them: the stretch
@@ -1179,9 +1188,7 @@ void SegmentAdvector::Work::sample() {
     }
     const auto map = [&](const Eigen::Vector3d* x, std::size_t n, Eigen::Vector3d* y,
                          MapScratch& scratch) { seg->inverseMaps(x, n, y, scratch); };
-    // A tear's seeds are estimated otherwise (renormalizeChanged).
-    dividesByStretch = options->sampling == Sampling::Corrected && !tearing;
-    if (dividesByStretch) fit(gradientBefore, moving.size());
+    if (dividesByStretch()) fit(gradientBefore, moving.size());
     // Sampling reads the grid itself and writes beside it (staged), or, from a widened band,
     // reads the copies that hold it and writes into the grid.
     const auto from =
@@ -1190,7 +1197,7 @@ void SegmentAdvector::Work::sample() {
     stats.sampledVoxels =
         resample(*grid, moving, *from, !widened, region, map, tearing, tornWindow,
                  options->sampling, changes(), options->interrupter, resampling, nullptr,
-                 widened ? nullptr : &staged, dividesByStretch ? &gradientBefore : nullptr);
+                 widened ? nullptr : &staged, dividesByStretch() ? &gradientBefore : nullptr);
     if (!widened) {
         staged.swapInto(moving);
         stats.leavesCopied += moving.size();
@@ -1259,7 +1266,7 @@ void SegmentAdvector::Work::renormalizeChanged() {
     const auto pass = [&](Seeding seeding) {
         const FmmStats fmm = renormalize(*grid, touched, freed, moved, options->renormalization,
                                          options->interrupter, seeding,
-                                         dividesByStretch ? &gradientBefore : nullptr);
+                                         dividesByStretch() ? &gradientBefore : nullptr);
         stats.leavesVisited += fmm.leaves;
         stats.voxelsVisited += fmm.leaves * LeafNode::SIZE;
     };

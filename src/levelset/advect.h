@@ -34,15 +34,13 @@ namespace sweepers {
 //    t (1 - t) along each axis: it reads a distance high next to a convex surface (inside
 //    and out) and low next to a concave one, and rounds the shape off at every segment.
 //  Corrected: trilinear less that term, with the second differences of the cell's corners
-//    interpolated, where the value lies within kCorrectedReach voxels of the surface (farther
+//    interpolated, where the value lies within two and a half voxels of the surface (farther
 //    out the differences read the band's clamp): it reads every quadratic field exactly. Its
 //    seeds are divided by the stretch the segment made (fast_marching.h), not by their
 //    gradient's norm, which reads low wherever the surface curves within a few voxels and
 //    would let it creep.
 //  MonotoneCubic: the monotone cubic of appendix C.1 (64 values per sample).
 enum class Sampling { Trilinear, Corrected, MonotoneCubic };
-
-inline constexpr double kCorrectedReach = 2.5;
 
 struct AdvectOptions {
     bool resampleEachSubStep = false; // the thesis's 5.3.4 variant

@@ -389,7 +389,8 @@ class Renormalizer {
           neg_(new Bits[b_.leafCount()]), fixed_(new Bits[b_.leafCount()]),
           settled_(new Bits[b_.leafCount()]), beyond_(new Bits[b_.leafCount()]),
           layout_(b_.leafCount(), 2) {
-        if (gradientBefore)
+        // Only smooth deformations' seeds divide by the stretch (Seeding).
+        if (gradientBefore && seeding == Seeding::Lower)
             for (const LeafValues& leaf : *gradientBefore)
                 if (const int l = b_.indexOf(leaf.origin); l >= 0)
                     gradientBefore_[std::size_t(l)] = leaf.values.data();
@@ -668,7 +669,7 @@ class Renormalizer {
     // where none was given.
     float gradientBefore(std::size_t i) const {
         const float* values = gradientBefore_[i >> 9];
-        return values && seeding_ == Seeding::Lower ? values[i & 511] : 0.0f;
+        return values ? values[i & 511] : 0.0f;
     }
 
     // The distance to the linear surface through the crossings of the 3x3x3 block around
