@@ -36,6 +36,10 @@ constexpr double kUnitSlack = 0.01;
 // linearly (trilinear sampling, marching cubes' edge crossings) puts on a curved surface,
 // and the central value, whose own bias partly cancels it, places the surface better.
 constexpr double kSecondOrderSlack = 0.05;
+// The same for a seed divided by the stretch (in voxels): a hundredth, the change advection
+// leaves out as a nudge. Below it the two differ by the model's own error (its second
+// differences), and taking it at every segment of a long stroke lets the surface creep.
+constexpr double kStretchedSecondOrderSlack = 0.01;
 
 using Leaf = Grid::TreeType::LeafNodeType;
 constexpr int kLeafVoxels = Leaf::SIZE; // 512, offset = x * 64 + y * 8 + z
@@ -560,7 +564,8 @@ class Renormalizer {
     // 1. Seeds (voxels with a face neighbour across the surface): phi / |grad phi| with
     //    central differences, which turns a sampled field that is no longer a distance back
     //    into one to second order where the field is smooth, capped by the distance to the
-    //    nearest axis crossing (the surface is no farther); in a second pass (Seeding::
+    //    nearest axis crossing (the surface is no farther), or, given the norms before,
+    //    phi over the stretch or the root of phi's second-order model; in a second pass (Seeding::
     //    Interface), the distance to the linear surface through the crossings. The sign is
     //    always kept.
     std::size_t seed() {
@@ -612,12 +617,21 @@ class Renormalizer {
                 d = s; // no farther than the nearest crossing: the surface passes through it
             } else if (const float before = gradientBefore(i);
                        before > 0.0f && grad2 > 1e-12 * double(h) * h) {
-                // The stretch the deformation made here: the value is a distance divided by it
+                // The stretch the deformation made here: the value is a distance times it
                 // where the values were one before (a seed's, or the upwind solution's).
                 const double stretch = std::sqrt(grad2) / h / before;
-                d = std::abs(stretch - 1.0) < kUnitSlack
-                        ? std::abs(p)
-                        : std::min(float(std::abs(p) / stretch), nearestCrossing * h);
+                if (std::abs(stretch - 1.0) < kUnitSlack) {
+                    d = std::abs(p);
+                } else {
+                    d = std::min(float(std::abs(p) / stretch), nearestCrossing * h);
+                    // Where the stretch changes along the normal (a pull's falloff), phi /
+                    // stretch errs by its relative change per voxel times the squared distance,
+                    // a few hundredths of a voxel: the root of the second-order model of phi,
+                    // its gradient read against the same norms, replaces it where they differ.
+                    const float d2 = std::min(secondOrderDistance(i, face, before),
+                                              nearestQuadraticCrossing(i, face) * h);
+                    if (std::abs(d - d2) > float(kStretchedSecondOrderSlack) * h) d = d2;
+                }
             } else if (grad2 > 1e-12 * double(h) * h) {
                 const double gradNorm = std::sqrt(grad2) / h;
                 // A value whose gradient is already unit within kUnitSlack is a distance: kept,
@@ -690,19 +704,46 @@ class Renormalizer {
         return distanceToLinearSurface(block) * h_;
     }
 
+    // The distance (in voxels) to the nearest crossing along an axis of the parabola through
+    // the voxel's value and its two face neighbours' there: the cap of a second-order seed,
+    // as the linear crossing caps a first-order one (the parabola and the linear edge cross at
+    // the same point only where phi is linear along the axis). `face` as in seed(), all six
+    // in the domain.
+    float nearestQuadraticCrossing(std::size_t i, const std::size_t (&face)[3][2]) const {
+        const double p = phi(i);
+        float nearest = kInf;
+        for (int a = 0; a < 3; ++a)
+            for (const int dir : {-1, 1}) {
+                const double q = phi(face[a][dir > 0]), m = phi(face[a][dir < 0]);
+                if (negative(float(q)) == negative(float(p))) continue;
+                // p + b t + c t^2 from t = -1 (m) to t = 1 (q): one root in (0, 1), since p
+                // and q differ in sign; written so that it does not cancel as c goes to 0.
+                const double b = 0.5 * (q - m), c = 0.5 * (q + m) - p;
+                const double disc = std::max(b * b - 4.0 * c * p, 0.0);
+                const double k = -0.5 * (b + std::copysign(std::sqrt(disc), b));
+                double t = k != 0.0 ? p / k : 1.0;
+                if (!(t > 0.0 && t <= 1.0) && c != 0.0) t = k / c;
+                if (!(t > 0.0 && t <= 1.0)) t = p / (p - q); // rounding: the linear one
+                nearest = std::min(nearest, float(std::max(t, 1e-6)));
+            }
+        return nearest;
+    }
+
     // |s| h for the root s (in voxels) nearest the voxel of the quadratic model of phi along
     // its normal, phi + g s + c s^2 / 2 = 0, with g = |grad phi| and c = n^T H n (n = grad
     // phi / g) from central differences on the 3x3x3 block: a distance along the normal to
     // second order, where phi / |grad phi| is one to first order. `face` holds the voxel's six
     // face neighbours (all in the domain, and a nonzero gradient: seed() asks only then). The
     // first-order value where a corner of the block lies outside the domain or the model has
-    // no real root.
-    float secondOrderDistance(std::size_t i, const std::size_t (&face)[3][2]) const {
+    // no real root. `unit` is the gradient's norm central differences read where the values
+    // were a distance (the stretch's reference, gradientBefore()): g is divided by it.
+    float secondOrderDistance(std::size_t i, const std::size_t (&face)[3][2],
+                              float unit = 1.0f) const {
         const double p = phi(i);
         double g[3], H[3][3];
         for (int a = 0; a < 3; ++a) {
             const double minus = phi(face[a][0]), plus = phi(face[a][1]);
-            g[a] = 0.5 * (plus - minus);
+            g[a] = 0.5 * (plus - minus) / unit;
             H[a][a] = plus - 2.0 * p + minus;
         }
         const double g2 = g[0] * g[0] + g[1] * g[1] + g[2] * g[2], gn = std::sqrt(g2);

@@ -8,7 +8,8 @@
 //     twentieth of a voxel lower (the field bends within the voxel; after a tear, lower or
 //     higher), or, in a second pass after a tear, the distance to the surface the values
 //     place (Seeding); given the gradient norms the values had before a deformation, phi
-//     over the stretch it made instead (renormalize()). Values whose gradient (or stretch) is
+//     over the stretch it made instead, or the second-order root where it lies more than a
+//     hundredth of a voxel from that (renormalize()). Values whose gradient (or stretch) is
 //     already unit within 1%, and values on or within two voxels of a feature one voxel thin
 //     (but for that cap), are kept, and so are seeds whose stencil a deformation did not
 //     change (the `moved` overload): the estimate is not idempotent where the surface
@@ -86,7 +87,12 @@ FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelLi
 // read a distance's gradient below 1 wherever the surface curves within a few voxels, so a
 // seed divided by its own gradient's norm grows each time it is seeded again: the surface
 // sharpens what curves, which trilinear sampling's rounding roughly cancels, but which
-// creeps under a sampling that does not round (advect.h, Sampling::Corrected).
+// creeps under a sampling that does not round (advect.h, Sampling::Corrected). Where the
+// stretch changes along the normal (a pull stretches the band more near the tool than
+// away), phi over the stretch errs by its relative change per voxel times the squared
+// distance: the root of the second-order model of phi along the normal (its gradient
+// divided by the norm before, as the stretch is) takes its place where the two differ by
+// more than a hundredth of a voxel.
 FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
                      const VoxelList& moved, FmmOrder order = FmmOrder::Second,
                      Interrupter* interrupter = nullptr, Seeding seeding = Seeding::Lower,

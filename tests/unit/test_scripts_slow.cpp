@@ -76,17 +76,17 @@ struct Unexplained {
 };
 const std::map<std::string, Unexplained> kUnexplained = {
     {"drag", {0, 0}},
-    {"finger", {0, 20}},
-    {"horn", {0, 2}},
-    {"mirrored_ears", {0, 8}},
+    {"finger", {0, 10}},
+    {"horn", {0, 0}},
+    {"mirrored_ears", {0, 0}},
     {"pinch", {0, 0}},
-    {"pinch_torus", {52, 0}},
+    {"pinch_torus", {30, 0}},
     {"pull", {0, 0}},
-    {"severed_horn", {12, 36}},
+    {"severed_horn", {6, 42}},
     {"starfish_swirls", {0, 0}},
-    {"strangle_torus", {125, 137}},
-    {"twisted_limb", {0, 2}},
-    {"two_handles", {14, 112}},
+    {"strangle_torus", {128, 136}},
+    {"twisted_limb", {0, 4}},
+    {"two_handles", {14, 106}},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
