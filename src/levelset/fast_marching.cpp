@@ -721,7 +721,7 @@ class Renormalizer {
                 const double b = 0.5 * (q - m), c = 0.5 * (q + m) - p;
                 const double disc = std::max(b * b - 4.0 * c * p, 0.0);
                 const double k = -0.5 * (b + std::copysign(std::sqrt(disc), b));
-                double t = k != 0.0 ? p / k : 1.0;
+                double t = k != 0.0 ? p / k : -1.0;
                 if (!(t > 0.0 && t <= 1.0) && c != 0.0) t = k / c;
                 if (!(t > 0.0 && t <= 1.0)) t = p / (p - q); // rounding: the linear one
                 nearest = std::min(nearest, float(std::max(t, 1e-6)));
