@@ -39,9 +39,13 @@ constexpr int kSeedReach = 2;
 // differences read the band's clamp.
 constexpr double kCorrectedReach = 2.5;
 
-// The values a seed of renormalization has after sampling, in voxels: those of a crossing's
-// ends, but for a stretch that spreads them (there the gradient's own norm serves).
-constexpr double kSeedValues = 1.5;
+// How far from the surface (in voxels) sampling records the norm of the old values'
+// gradient that a seed is divided by (renormalize()): as far as the corrected sample reads
+// its corners' differences. A seed's value is within a voxel and a half where the field is
+// still a distance, but a field the segment compressed puts it farther out (two voxels and
+// more on a pinch's hole wall, at a pulled tip), and such a seed, divided by its own
+// gradient's norm, took a value the eikonal test refused.
+constexpr double kSeedValues = kCorrectedReach;
 
 // How many interface voxels a thread maps through the sub-steps at once: enough for the
 // batched maps to pay, few enough for the points to stay in cache.

@@ -76,17 +76,17 @@ struct Unexplained {
 };
 const std::map<std::string, Unexplained> kUnexplained = {
     {"drag", {0, 0}},
-    {"finger", {0, 10}},
+    {"finger", {0, 4}},
     {"horn", {0, 0}},
     {"mirrored_ears", {0, 0}},
     {"pinch", {0, 0}},
-    {"pinch_torus", {30, 0}},
+    {"pinch_torus", {0, 0}},
     {"pull", {0, 0}},
-    {"severed_horn", {6, 42}},
+    {"severed_horn", {2, 42}},
     {"starfish_swirls", {0, 0}},
-    {"strangle_torus", {128, 136}},
+    {"strangle_torus", {13, 136}},
     {"twisted_limb", {0, 4}},
-    {"two_handles", {14, 106}},
+    {"two_handles", {14, 104}},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
