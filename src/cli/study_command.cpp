@@ -59,8 +59,7 @@ std::vector<StudyVariant> parseVariants(const std::string& list) {
     while (std::getline(in, item, ',')) {
         const auto v = parseVariant(item);
         if (!v)
-            throw UsageError("--variants: unknown variant '" + item +
-                             "' (corrected, trilinear, cubic, per-substep, first-order)");
+            throw UsageError("--variants: unknown variant '" + item + "' (" + variantNames() + ")");
         if (std::find(out.begin(), out.end(), *v) == out.end()) out.push_back(*v);
     }
     if (out.empty()) throw UsageError("--variants: no variant given");
@@ -413,7 +412,7 @@ CLI::App* addStudyCommand(CLI::App& app, StudyArgs& a) {
     study->add_option("--voxel-sizes", a.voxelSizes,
                       "Voxel sizes, decimals or 1/N (default 1/32,1/64,1/128,1/256)");
     study->add_option("--variants", a.variants,
-                      "corrected, trilinear, cubic, per-substep, first-order (default corrected)");
+                      variantNames() + " (default " + variantName(StudyVariant::Corrected) + ")");
     study->add_flag("--force", a.force,
                     "Build start shapes even when they seem to need more memory than is free");
     study->add_option("--jobs", a.jobs, "Runs at once here, the threads split between them")

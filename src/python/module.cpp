@@ -402,9 +402,8 @@ py::object study(const py::object& scripts, const py::object& voxelSizes,
                                                                 : py::list(variants)) {
         const auto kind = parseVariant(v.cast<std::string>());
         if (!kind)
-            throw std::invalid_argument(
-                "variants: unknown variant '" + v.cast<std::string>() +
-                "' (corrected, trilinear, cubic, per-substep, first-order)");
+            throw std::invalid_argument("variants: unknown variant '" + v.cast<std::string>() +
+                                        "' (" + variantNames() + ")");
         kinds.push_back(*kind);
     }
     if (paths.empty() || sizes.empty() || kinds.empty())

@@ -55,11 +55,25 @@ std::string variantName(StudyVariant v) {
     return "";
 }
 
+namespace {
+
+constexpr StudyVariant kVariants[] = {StudyVariant::Corrected, StudyVariant::Trilinear,
+                                      StudyVariant::Cubic, StudyVariant::PerSubStep,
+                                      StudyVariant::FirstOrder};
+
+} // namespace
+
 std::optional<StudyVariant> parseVariant(const std::string& name) {
-    for (StudyVariant v : {StudyVariant::Corrected, StudyVariant::Trilinear, StudyVariant::Cubic,
-                           StudyVariant::PerSubStep, StudyVariant::FirstOrder})
+    for (StudyVariant v : kVariants)
         if (variantName(v) == name) return v;
     return std::nullopt;
+}
+
+std::string variantNames() {
+    std::string names;
+    for (StudyVariant v : kVariants)
+        names += (names.empty() ? "" : ", ") + variantName(v);
+    return names;
 }
 
 AdvectOptions variantOptions(StudyVariant v) {

@@ -21,6 +21,8 @@ enum class StudyVariant { Corrected, Trilinear, Cubic, PerSubStep, FirstOrder };
 // corrected, trilinear, cubic, per-substep, first-order.
 std::string variantName(StudyVariant v);
 std::optional<StudyVariant> parseVariant(const std::string& name);
+// Every variant's name, in that order, joined by ", " (for messages and help).
+std::string variantNames();
 // The engine's options for a variant: the default engine (corrected trilinear sampling of
 // the composed inverse, second-order fast marching), plain trilinear sampling (the thesis's
 // 5.3.2), the monotone cubic of appendix C.1, one resample per sub-step (5.3.4), or
