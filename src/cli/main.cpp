@@ -229,6 +229,10 @@ int runInfo(const std::string& path, const std::string& gridName) {
         j["thin_feature_bbox"] = peer.thinBox.empty()
                                      ? json(nullptr)
                                      : json{vec(peer.thinBox.min), vec(peer.thinBox.max)};
+        j["eikonal_outliers_elsewhere_bbox"] =
+            peer.elsewhereBox.empty()
+                ? json(nullptr)
+                : json{vec(peer.elsewhereBox.min), vec(peer.elsewhereBox.max)};
         std::cout << j.dump(2) << "\n";
         return 0;
     }
@@ -259,6 +263,11 @@ int runInfo(const std::string& path, const std::string& gridName) {
         std::printf("    its gradient test refuses %zu of the %zu voxels next to the surface; %zu "
                     "of them lie on features thinner than its stencil reads\n",
                     peer.eikonal, peer.surfaceVoxels, peer.eikonalThin);
+    if (peer.eikonal > peer.eikonalThin)
+        std::printf("    the other %zu lie in [%g %g %g] - [%g %g %g]\n",
+                    peer.eikonal - peer.eikonalThin, peer.elsewhereBox.min.x(),
+                    peer.elsewhereBox.min.y(), peer.elsewhereBox.min.z(), peer.elsewhereBox.max.x(),
+                    peer.elsewhereBox.max.y(), peer.elsewhereBox.max.z());
     if (peer.thinVoxels > 0)
         std::printf("  thin features (two surfaces, or a ridge of the distance, within 3 voxels): "
                     "%zu voxels next to the surface, in [%g %g %g] - [%g %g %g]\n",

@@ -63,7 +63,7 @@ bool onThinFeature(const Grid::ConstAccessor& acc, const Sampler& sample, const 
 
 struct Counts {
     std::size_t eikonal = 0, eikonalThin = 0, surface = 0, thin = 0;
-    openvdb::CoordBBox thinBox;
+    openvdb::CoordBBox thinBox, elsewhereBox;
 };
 
 } // namespace
@@ -98,6 +98,7 @@ PeerCheck peerCheck(const Grid& grid) {
                     if (g2 < 0.5f || g2 > 1.5f) {
                         ++acc.eikonal;
                         acc.eikonalThin += thin;
+                        if (!thin) acc.elsewhereBox.expand(it.getCoord());
                     }
                 }
             return acc;
@@ -108,17 +109,18 @@ PeerCheck peerCheck(const Grid& grid) {
             a.surface += b.surface;
             a.thin += b.thin;
             a.thinBox.expand(b.thinBox);
+            a.elsewhereBox.expand(b.elsewhereBox);
             return a;
         });
     r.eikonal = c.eikonal;
     r.eikonalThin = c.eikonalThin;
     r.surfaceVoxels = c.surface;
     r.thinVoxels = c.thin;
-    if (c.thin > 0) {
-        const openvdb::Vec3d lo = grid.indexToWorld(c.thinBox.min()),
-                             hi = grid.indexToWorld(c.thinBox.max());
-        r.thinBox = Box(toEigen(lo), toEigen(hi));
-    }
+    const auto worldBox = [&](const openvdb::CoordBBox& b) {
+        return Box(toEigen(grid.indexToWorld(b.min())), toEigen(grid.indexToWorld(b.max())));
+    };
+    if (c.thin > 0) r.thinBox = worldBox(c.thinBox);
+    if (c.eikonal > c.eikonalThin) r.elsewhereBox = worldBox(c.elsewhereBox);
     return r;
 }
 

@@ -31,6 +31,9 @@ struct PeerCheck {
     std::size_t surfaceVoxels = 0; // voxels next to the surface (those the test reads)
     std::size_t thinVoxels = 0;    // ... of which on thin features
     Box thinBox;                   // world box of those, empty when none
+    // World box of the refused voxels not on thin features, empty when none: where to look
+    // for a complaint the shape does not account for.
+    Box elsewhereBox;
 };
 
 // Runs OpenVDB's checks and classifies the eikonal test's voxels.

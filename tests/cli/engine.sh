@@ -98,6 +98,8 @@ assert 2.2 < info["bbox"][1][1] < 2.6, info["bbox"]
 assert isinstance(info["openvdb_check"], str), info
 assert 0 <= info["eikonal_outliers_on_thin_features"] <= info["eikonal_outliers"], info
 assert (info["thin_feature_bbox"] is None) == (info["thin_feature_voxels"] == 0), info
+assert (info["eikonal_outliers_elsewhere_bbox"] is None) == (
+    info["eikonal_outliers"] == info["eikonal_outliers_on_thin_features"]), info
 PY
 "$cli" info "$tmp/horn.vdb" | grep -q "OpenVDB's checkLevelSet: " || fail "info: no word of checkLevelSet"
 "$cli" mesh "$tmp/horn.vdb" -o "$tmp/horn.obj" 2>/dev/null

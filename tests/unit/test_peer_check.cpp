@@ -2,6 +2,7 @@
 // gradient test refuses where a distance itself has no unit gradient.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "grids.h"
@@ -35,6 +36,28 @@ TEST(PeerCheck, ASphereIsAcceptedAndHasNoThinFeature) {
     EXPECT_GT(r.surfaceVoxels, 1000u);
     EXPECT_EQ(r.thinVoxels, 0u);
     EXPECT_TRUE(r.thinBox.empty());
+    EXPECT_TRUE(r.elsewhereBox.empty());
+}
+
+TEST(PeerCheck, SaysWhereTheComplaintsNoThinFeatureAccountsForLie) {
+    // A sphere whose values are stretched by up to 1.6 on the side x > 0.3 (smoothly, so no
+    // crease): no distance there, and no thin feature either.
+    const auto stretch = [](double x) {
+        const double t = std::clamp((x - 0.3) / 0.2, 0.0, 1.0);
+        return 1.0 + 0.6 * t * t * (3.0 - 2.0 * t);
+    };
+    const GridPtr g = test::gridFromSdf(
+        [&](const Eigen::Vector3d& p) { return (p.norm() - 0.6) * stretch(p.x()); }, kSheetVoxel,
+        3.0, {openvdb::Coord(-24), openvdb::Coord(24)});
+    const PeerCheck r = peerCheck(*g);
+    std::printf("[ peer ] a stretched sphere: %zu refused, %zu of them thin, the others in "
+                "x [%g, %g]\n",
+                r.eikonal, r.eikonalThin, r.elsewhereBox.min.x(), r.elsewhereBox.max.x());
+    EXPECT_GT(r.eikonal, 100u);
+    EXPECT_EQ(r.eikonalThin, 0u);
+    ASSERT_FALSE(r.elsewhereBox.empty());
+    EXPECT_GT(r.elsewhereBox.min.x(), 0.3);
+    EXPECT_LT(r.elsewhereBox.max.x(), 0.6 + 2 * kSheetVoxel);
 }
 
 TEST(PeerCheck, ASheetThinnerThanTheStencilIsAThinFeatureAndExplainsTheComplaint) {
