@@ -261,7 +261,7 @@ int runInfo(const std::string& path, const std::string& gridName) {
                 peer.message.empty() ? "no complaint" : peer.message.c_str());
     if (peer.eikonal > 0)
         std::printf("    its gradient test refuses %zu of the %zu voxels next to the surface; %zu "
-                    "of them lie on features thinner than its stencil reads\n",
+                    "of them lie on features finer than its stencil reads\n",
                     peer.eikonal, peer.surfaceVoxels, peer.eikonalThin);
     if (peer.eikonal > peer.eikonalThin)
         std::printf("    the other %zu lie in [%g %g %g] - [%g %g %g]\n",
@@ -269,8 +269,8 @@ int runInfo(const std::string& path, const std::string& gridName) {
                     peer.elsewhereBox.min.y(), peer.elsewhereBox.min.z(), peer.elsewhereBox.max.x(),
                     peer.elsewhereBox.max.y(), peer.elsewhereBox.max.z());
     if (peer.thinVoxels > 0)
-        std::printf("  thin features (two surfaces, or a ridge of the distance, within 3 voxels): "
-                    "%zu voxels next to the surface, in [%g %g %g] - [%g %g %g]\n",
+        std::printf("  thin features (two surfaces or a ridge of the distance within 3 voxels, or "
+                    "a crease): %zu voxels next to the surface, in [%g %g %g] - [%g %g %g]\n",
                     peer.thinVoxels, peer.thinBox.min.x(), peer.thinBox.min.y(),
                     peer.thinBox.min.z(), peer.thinBox.max.x(), peer.thinBox.max.y(),
                     peer.thinBox.max.z());

@@ -14,11 +14,16 @@ namespace sweepers {
 
 namespace {
 
+// The exact distance of an edge where the surface turns by about 30 degrees or more (sharp,
+// or rounded within a voxel) fails the eikonal test next to the edge, and there the central
+// differences of c and a face neighbour straddle the kink and see about half that turn.
+constexpr double kCreaseTurnDegrees = 15.0;
+
 // Along the normal (the central gradient) through c, sampled each voxel for three voxels
 // either way: the surface is crossed more than once (a sheet or a gap thinner than that),
 // or |phi| stops growing away from the surface on either side (a ridge of the distance,
 // the medial axis of a part thinner than that).
-// Or a crease: the normal turns by more than 40 degrees from c to a face neighbour.
+// Or a crease: the normal turns by more than kCreaseTurnDegrees from c to a face neighbour.
 template <typename Sampler>
 bool onThinFeature(const Grid::ConstAccessor& acc, const Sampler& sample, const openvdb::Coord& c,
                    float h) {
@@ -33,13 +38,13 @@ bool onThinFeature(const Grid::ConstAccessor& acc, const Sampler& sample, const 
     openvdb::Vec3d n = normal(c);
     if (n.lengthSqr() < 1e-12 * h * h) return true; // no direction at all: a ridge
     n.normalize();
-    const double cos40 = std::cos(40.0 * M_PI / 180.0);
+    const double cosCrease = std::cos(kCreaseTurnDegrees * M_PI / 180.0);
     for (int a = 0; a < 3; ++a)
         for (const int d : {-1, 1}) {
             openvdb::Coord q = c;
             q[a] += d;
             const openvdb::Vec3d m = normal(q);
-            if (m.lengthSqr() < 1e-12 * h * h || m.unit().dot(n) < cos40) return true;
+            if (m.lengthSqr() < 1e-12 * h * h || m.unit().dot(n) < cosCrease) return true;
         }
     float row[7];
     const openvdb::Vec3d at = c.asVec3d();

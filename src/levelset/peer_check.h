@@ -12,8 +12,10 @@
 // either way, the surface is crossed twice (a sheet or a gap thinner than that) or |phi|
 // stops growing away from the surface (a ridge of the distance: the medial axis of a part
 // thinner than that), or where the surface creases: the normal (the central gradient)
-// turns by more than 40 degrees from the voxel to a face neighbour, as at a box's edge,
-// where the medial axis meets the surface.
+// turns by more than 15 degrees from the voxel to a face neighbour, as at a box's edge,
+// where the medial axis meets the surface. The exact distance of an edge fails the test
+// from a turn of about 30 degrees, which the central differences next to it see as half;
+// the same test takes in parts under about four voxels in radius.
 #pragma once
 
 #include <cstddef>

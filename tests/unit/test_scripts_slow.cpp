@@ -66,27 +66,14 @@ const std::map<std::string, std::vector<std::pair<int, std::size_t>>> kTopology 
     {"severed_horn", {{2, 1}, {4, 2}}},   // a pulled horn, then cut off
 };
 
-// What OpenVDB's checkLevelSet (all nine tests) refuses in a script's result: the voxels
-// its eikonal test refuses and the info report does not put on a feature the grid does not
-// resolve (thin parts, gaps, creases: levelset/peer_check.h), at most as many as measured
-// when this test was written (none is the goal): at the scripts' voxel sizes, and at the
-// coarse variant's twice them. Any other complaint fails.
-struct Unexplained {
-    std::size_t fine, coarse;
-};
-const std::map<std::string, Unexplained> kUnexplained = {
-    {"drag", {0, 0}},
-    {"finger", {0, 4}},
-    {"horn", {0, 0}},
-    {"mirrored_ears", {0, 0}},
-    {"pinch", {0, 0}},
-    {"pinch_torus", {0, 0}},
-    {"pull", {0, 0}},
-    {"severed_horn", {2, 42}},
-    {"starfish_swirls", {0, 0}},
-    {"strangle_torus", {13, 136}},
-    {"twisted_limb", {0, 4}},
-    {"two_handles", {14, 104}},
+// What OpenVDB's checkLevelSet (all nine tests) refuses in a script's result that the info
+// report does not put on a feature the grid does not resolve (thin parts, gaps, creases:
+// levelset/peer_check.h): at the scripts' own voxel sizes, nothing; at twice them, where the
+// lips of the torn scripts' mouths are about a voxel across, at most as many as measured when
+// this test was written (none is the goal).
+const std::map<std::string, std::size_t> kUnexplainedAtTwiceTheVoxelSize = {
+    {"strangle_torus", 12},
+    {"two_handles", 32},
 };
 
 TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
@@ -116,14 +103,15 @@ TEST_P(DataScript, KeepsAValidNarrowBandAfterEveryStroke) {
     });
 }
 
-// OpenVDB's checkLevelSet on each script's result (kUnexplained).
-TEST_P(DataScript, OpenVdbsCheckRefusesNoMoreThanKnown) {
+// OpenVDB's checkLevelSet on each script's result, at its own voxel size and at twice it
+// (whichever variant runs: the check costs little).
+TEST_P(DataScript, OpenVdbsCheckRefusesOnlyWhatTheReportExplains) {
     const std::string name = GetParam();
     const StrokeScript script = readStrokeScript(dataPath(name));
-    const double h = voxelSize(script.grid.voxelSize);
-    applyScript(script, SWEEPERS_DATA_DIR, h, [&](std::size_t stroke, const Grid& g) {
-        if (stroke + 1 < script.strokes.size()) return;
-        const PeerCheck peer = peerCheck(g);
+    for (const double scale : {1.0, 2.0}) {
+        const double h = scale * script.grid.voxelSize;
+        const GridPtr g = applyScript(script, SWEEPERS_DATA_DIR, h);
+        const PeerCheck peer = peerCheck(*g);
         const std::size_t unexplained = peer.eikonal - peer.eikonalThin;
         std::printf("[ peer ] %s at 1/%g: checkLevelSet refuses %zu of %zu voxels next to "
                     "the surface, %zu of them on features the grid does not resolve\n",
@@ -133,9 +121,11 @@ TEST_P(DataScript, OpenVdbsCheckRefusesNoMoreThanKnown) {
         else
             EXPECT_NE(peer.message.find("outside the range of NormGrad"), std::string::npos)
                 << name << ": " << peer.message;
-        const Unexplained& most = kUnexplained.at(name);
-        EXPECT_LE(unexplained, coarse() ? most.coarse : most.fine) << name;
-    });
+        const auto known = kUnexplainedAtTwiceTheVoxelSize.find(name);
+        const std::size_t most =
+            scale == 1.0 || known == kUnexplainedAtTwiceTheVoxelSize.end() ? 0 : known->second;
+        EXPECT_LE(unexplained, most) << name << " at 1/" << 1.0 / h;
+    }
 }
 
 // The mesh a Sculptor keeps up to date, segment by segment from what each segment reports it
