@@ -563,12 +563,16 @@ PYBIND11_MODULE(sweepers, m) {
             "The shape now, as a Shape that later strokes do not change.");
     addShapeMethods(sculptor, [](const Session& s) { return s.view(); });
 
+    // The variants' names from the list the parser reads; kept for the module's lifetime.
+    static const std::string studyDoc =
+        "Runs a grid-resolution study (docs/studies.md) of one or more scripts at each voxel "
+        "size (numbers or '1/N') and variant (" +
+        variantNames() +
+        ") and returns its rows, keyed by the columns of study.csv: a pandas DataFrame when "
+        "pandas is installed, else a list of dicts. In `directory` (kept, and resumed from) or "
+        "a temporary one. `progress` sees runs done and in all.";
     m.def("study", &study, py::arg("scripts"), py::arg("voxel_sizes"),
-          py::arg("variants") = py::make_tuple("corrected"), py::arg("directory") = py::none(),
-          py::arg("force") = false, py::arg("progress") = py::none(),
-          "Runs a grid-resolution study (docs/studies.md) of one or more scripts at each voxel "
-          "size (numbers or '1/N') and variant ('corrected', 'trilinear', 'cubic', 'per-substep', "
-          "'first-order') and returns its rows, keyed by the columns of study.csv: a pandas "
-          "DataFrame when pandas is installed, else a list of dicts. In `directory` (kept, and "
-          "resumed from) or a temporary one. `progress` sees runs done and in all.");
+          py::arg("variants") = py::make_tuple(variantName(StudyVariant::Corrected)),
+          py::arg("directory") = py::none(), py::arg("force") = false,
+          py::arg("progress") = py::none(), studyDoc.c_str());
 }
