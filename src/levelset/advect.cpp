@@ -1058,6 +1058,13 @@ void SegmentAdvector::Work::widenSource() {
                redo.end());
     renormalize(*source, indexBox(*grid, seg->affectedBox(), int(needed) + 1), redo, redo,
                 FmmOrder::First, options->interrupter);
+    // Beyond the band, the copy reads the grid's own clamp again: where no leaf was widened
+    // (far from the stretch, across the box of a deformation that reaches the whole shape,
+    // as an inflation does), a sample next to the band's edge reads past it, and the wider
+    // clamp there (needed voxels instead of the band's) would bend the values it reads
+    // towards it, corrected sampling's second differences most (a sign flips three voxels
+    // out). The widened leaves' active voxels keep their distances.
+    openvdb::tools::changeLevelSetBackground(source->tree(), grid->background());
     widened = source;
 }
 
