@@ -21,7 +21,9 @@ namespace sweepers {
 namespace {
 
 // Bumped when the solver changes what it computes, so older cache files are solved again.
-constexpr int kSolverVersion = 2; // 2: the exact solves of the diffusion and the pressure
+// 3: the lattice's size kept with it (velocity_file.h), so that a run that reads the cache
+// makes the field of the same lattice as the run that solved it.
+constexpr int kSolverVersion = 3; // 2: the exact solves of the diffusion and the pressure
 
 std::string cacheDirectory() {
     if (const char* d = std::getenv("SWEEPERS_CACHE"); d && *d) return d;
@@ -102,7 +104,9 @@ std::shared_ptr<const SweptFluid> sweptFluid(const FluidSpec& spec, std::string*
     if (!fluid) {
         const auto start = Clock::now();
         const FluidSolution solution = solveSweptFluid(spec);
-        fluid = std::make_shared<SweptFluid>(solution.samples, spec.ballRadius);
+        // The samples as the cache gives them back, so that this run and the runs that read
+        // them sculpt the same grid, to the bit.
+        fluid = std::make_shared<SweptFluid>(storedSamples(solution.samples), spec.ballRadius);
         note += "solved the swept fluid (" + std::to_string(spec.cells) + "^3 cells) in " +
                 formatNumber(std::round(secondsSince(start) * 10.0) / 10.0) + " s";
         try {

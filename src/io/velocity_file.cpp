@@ -69,10 +69,35 @@ VelocitySamples readVelocitySamples(const std::string& path, const std::string& 
     return velocitySamples(readVelocityInChild(path, gridName), path);
 }
 
+namespace {
+
+// The lattice writeVelocity wrote, when the grid says so and its active voxels lie within it:
+// zero samples are stored inactive, so the active voxels alone can give a smaller lattice
+// (a solution whose walls are at rest loses its outer layers), and the field made of it a
+// smaller support.
+openvdb::CoordBBox latticeOf(const openvdb::Vec3SGrid& grid) {
+    const openvdb::CoordBBox active = grid.evalActiveVoxelBoundingBox();
+    const auto dims = grid.getMetadata<openvdb::Vec3IMetadata>(kLatticeDimsKey);
+    if (!dims || active.empty()) return active;
+    const openvdb::Vec3i d = dims->value();
+    if (d.x() < 1 || d.y() < 1 || d.z() < 1) return active;
+    const openvdb::CoordBBox lattice(openvdb::Coord(0),
+                                     openvdb::Coord(d.x() - 1, d.y() - 1, d.z() - 1));
+    return lattice.isInside(active) ? lattice : active;
+}
+
+} // namespace
+
+VelocitySamples storedSamples(VelocitySamples samples) {
+    for (Eigen::Vector3f& v : samples.values)
+        if (v.isZero()) v = Eigen::Vector3f::Zero(); // -0 too: stored inactive, read as +0
+    return samples;
+}
+
 VelocitySamples velocitySamples(const VelocityFile& file, const std::string& path) {
     const openvdb::Vec3SGrid& grid = *file.grid;
     // The child checked the grid; its lattice size is checked again before it is allocated.
-    const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
+    const openvdb::CoordBBox box = latticeOf(grid);
     if (box.empty() || double(box.dim().x()) * box.dim().y() * box.dim().z() > kMostVelocitySamples)
         throw FileError(path + ": velocity grid '" + file.name + "' " + unusable(grid));
     VelocitySamples s;
@@ -116,6 +141,8 @@ void writeVelocity(const VelocitySamples& samples, const std::string& path, cons
             }
     for (auto it = meta.beginMeta(); it != meta.endMeta(); ++it)
         grid->insertMeta(it->first, *it->second);
+    grid->insertMeta(kLatticeDimsKey, openvdb::Vec3IMetadata(openvdb::Vec3i(
+                                          samples.dims[0], samples.dims[1], samples.dims[2])));
     grid->insertMeta("creator", openvdb::StringMetadata("Sweepers"));
     prepareGrids(openvdb::GridCPtrVec{grid}, path).commit();
 }

@@ -32,10 +32,16 @@ VelocitySamples readVelocitySamples(const std::string& path, const std::string& 
 // The same, from a file read already (`path` for messages).
 VelocitySamples velocitySamples(const VelocityFile& file, const std::string& path);
 
+// The samples as reading what writeVelocity wrote gives them back: every zero vector +0.
+VelocitySamples storedSamples(VelocitySamples samples);
+
 constexpr double kMostVelocitySamples = 64.0 * 1024 * 1024; // 768 MB of float vectors
 
 // Writes the samples as a vec3s grid named `name` (zero samples left inactive), atomically
-// (io/atomic_file.h), with `meta` on the grid.
+// (io/atomic_file.h), with `meta` on the grid and the lattice's size (kLatticeDimsKey), so
+// that reading it gives back the same lattice (storedSamples) even where its outer samples
+// are zero.
+inline const char* const kLatticeDimsKey = "lattice_dims";
 void writeVelocity(const VelocitySamples& samples, const std::string& path, const std::string& name,
                    const openvdb::MetaMap& meta = {});
 

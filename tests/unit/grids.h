@@ -46,6 +46,30 @@ inline std::size_t differingVoxels(const Grid& a, const Grid& b) {
     return n;
 }
 
+// The voxels whose value (to the bit) or state differ, the tiles' values included: 0 when
+// the grids are the same grid.
+inline std::size_t differingBits(const Grid& a, const Grid& b) {
+    std::size_t n = 0;
+    const auto count = [&](const Grid& x, const Grid& y, bool both) {
+        const auto acc = y.getConstAccessor();
+        for (auto it = x.cbeginValueAll(); it; ++it) {
+            openvdb::CoordBBox box;
+            it.getBoundingBox(box);
+            const float v = *it;
+            const bool on = it.isValueOn();
+            // A tile is compared at its first voxel (a tile against leaves differs there, or
+            // at one of the leaves' voxels, which the other side's walk finds).
+            const openvdb::Coord c = box.min();
+            const float w = acc.getValue(c);
+            const bool different = std::memcmp(&v, &w, sizeof v) != 0 || on != acc.isValueOn(c);
+            if (different && (both || !it.isVoxelValue())) ++n;
+        }
+    };
+    count(a, b, true);
+    count(b, a, false);
+    return n;
+}
+
 // The voxels active in either grid whose value (to the bit) or state differs, that lie in
 // none of `boxes`.
 inline std::size_t changedOutside(const Grid& a, const Grid& b,

@@ -14,10 +14,13 @@
 
 #include "deform/box_solve.h"
 #include "deform/swept_fluid.h"
+#include "grids.h"
 #include "io/fluid_cache.h"
 #include "io/stroke_script.h"
 #include "io/velocity_file.h"
+#include "levelset/create.h"
 #include "random.h"
+#include "sculpt/sculptor.h"
 
 using namespace sweepers;
 using sweepers::test::Rng;
@@ -327,6 +330,49 @@ TEST(SweptFluid, TheCacheKeepsTheSolutionAndSurvivesDamageAndReadOnlyPlaces) {
     ASSERT_TRUE(third);
     EXPECT_GT(third->centerSpeed, 0.1);
     EXPECT_NE(said.find("could not keep it"), std::string::npos) << said;
+    if (had)
+        ::setenv("SWEEPERS_CACHE", old.c_str(), 1);
+    else
+        ::unsetenv("SWEEPERS_CACHE");
+}
+
+// The swept fluid made by the run that solves it and by the runs that read it from the cache
+// is the same field: the same lattice, the same samples, to the bit, so a fluid stroke
+// sculpts the same grid either way (a solver of few cells, so that it solves in a moment).
+TEST(SweptFluid, TheRunThatSolvesItAndTheRunsThatReadItSculptTheSameGrid) {
+    const std::string dir = ::testing::TempDir() + "/fluid_lattice_test";
+    std::filesystem::remove_all(dir);
+    const char* had = std::getenv("SWEEPERS_CACHE");
+    const std::string old = had ? had : "";
+    ::setenv("SWEEPERS_CACHE", dir.c_str(), 1);
+    FluidSpec spec;
+    spec.cells = 24;
+    spec.ballRadius = 4;
+    const auto solved = sweptFluid(spec); // solves, keeps it in the cache
+    ASSERT_TRUE(std::filesystem::exists(fluidCachePath(spec)));
+    const VelocitySamples read = readVelocitySamples(fluidCachePath(spec), "velocity");
+    const VelocitySamples made = solved->field->samples();
+    // The solver's outer layer is at rest (the closed walls): the lattice must keep it.
+    EXPECT_EQ(read.dims, made.dims);
+    EXPECT_EQ(read.origin, made.origin);
+    EXPECT_EQ(read.spacing, made.spacing);
+    ASSERT_EQ(read.values.size(), made.values.size());
+    EXPECT_EQ(std::memcmp(read.values.data(), made.values.data(),
+                          read.values.size() * sizeof(Eigen::Vector3f)),
+              0);
+    const auto fromFile = std::make_shared<SweptFluid>(read, spec.ballRadius);
+    FluidStroke stroke;
+    stroke.radius = 0.3;
+    stroke.path = {{0, 0.85, 0}, {0, 1.05, 0.1}};
+    GridPtr grids[2];
+    int k = 0;
+    for (const auto& fluid : {solved, std::shared_ptr<const SweptFluid>(fromFile)}) {
+        stroke.fluid = fluid;
+        Sculptor sculptor(makeSphere(Eigen::Vector3d::Zero(), 1.0, 1.0 / 32, 3.0));
+        sculptor.applyStroke(stroke);
+        grids[k++] = sculptor.gridPtr();
+    }
+    EXPECT_EQ(sweepers::test::differingBits(*grids[0], *grids[1]), 0u);
     if (had)
         ::setenv("SWEEPERS_CACHE", old.c_str(), 1);
     else
