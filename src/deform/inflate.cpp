@@ -1,15 +1,20 @@
 #include "deform/inflate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 namespace sweepers {
 
-Inflation::Inflation(const Eigen::Vector3d& centre, double radius, const Box& reach, bool remove)
-    : c_(centre), rho3_(radius * radius * radius), remove_(remove) {
+Inflation::Inflation(const Eigen::Vector3d& centre, double radius, const Box& reach, bool remove,
+                     InflationFill fill)
+    : c_(centre), rho_(radius), rho3_(radius * radius * radius), remove_(remove), fill_(fill) {
     if (!(radius > 0.0) || !std::isfinite(radius))
         throw std::invalid_argument("an inflation needs a positive radius");
+    if (!(fill.band >= 0.0) || !std::isfinite(fill.band) || !std::isfinite(fill.depth))
+        throw std::invalid_argument("an inflation's fill needs a finite band and depth");
     steps_ = 1;
+    fills_ = !remove && fill.band > 0.0 && fill.depth >= 0.0;
     affected_ = reach;
     affected_.add(Box(centre.array() - 2 * radius, centre.array() + 2 * radius));
 }
@@ -37,6 +42,24 @@ Eigen::Vector3d Inflation::inverseStep(int, const Eigen::Vector3d& p) const {
 ForwardResult Inflation::forwardStep(int, const Eigen::Vector3d& q, double) const {
     if (!affected_.contains(q)) return {q, true, 0};
     return {remove_ ? suckIn(q) : blowUp(q), true, 1};
+}
+
+double Inflation::surfaceRadius() const {
+    const double s = fill_.depth;
+    return std::cbrt(rho3_ + s * s * s);
+}
+
+double Inflation::filledValue(const Eigen::Vector3d& x, double value) const {
+    if (!fills_) return value;
+    const double r = (x - c_).norm(), out = r - surfaceRadius();
+    if (r < rho_) return std::max(out, -fill_.band); // the new ball: clay
+    return value > 0.0 && out > 0.0 && out < fill_.band ? std::min(value, out) : value;
+}
+
+Box Inflation::filledBox() const {
+    if (!fills_) return {};
+    const double r = surfaceRadius() + fill_.band;
+    return Box(c_.array() - r, c_.array() + r);
 }
 
 Sequence::Sequence(std::vector<std::unique_ptr<StepDeformation>> parts) : parts_(std::move(parts)) {

@@ -9,9 +9,21 @@
 // has no pre-image inside the ball: those voxels take the value at c, i.e. the material
 // (or emptiness) at the centre.
 //
-// The displacement decays like rho^3 / (3 |p - c|^2) and never vanishes, so the caller
-// gives the box beyond which it is neglected; the engine passes the shape's box, where
-// nothing but empty space lies beyond.
+// A centre on the surface leaves that value about zero across the whole new ball, with no
+// sign: the thesis's map is discontinuous there (just inside, the ball is clay and the shape
+// smooth; just outside, it is empty and the pushed surface closes round it in a cusp as thin
+// as a razor). For a centre at depth s inside, the new surface lies about s^3 / (3 rho^2)
+// beyond the ball's edge, where the inverse squeezes a whole band into the centre's
+// neighbourhood (its stretch grows without bound), and the values sampled there are no
+// distances. So an inflation whose centre lies within the band (where the grid knows s) fills
+// its ball (InflationFill): the value inside is the distance to the sphere of radius
+// (rho^3 + s^3)^(1/3) about c, which the new surface encloses and touches where the old
+// surface is nearest (a small fraction of a voxel from the edge, for s within the band), and
+// a value sampled just beyond the edge outside the shape is capped by the distance to that
+// sphere, no smaller than the distance to the new surface. The stroke first puts a centre
+// just outside the surface, within the band, on the surface along the normal
+// (sculpt/stroke.cpp).
+//
 #pragma once
 
 #include <memory>
@@ -22,21 +34,36 @@
 
 namespace sweepers {
 
+// How an inflation fills its new ball: `depth`, the centre's distance inside the surface (0
+// on it; negative: no fill, the thesis's value at c everywhere in the ball), and `band`, the
+// grid's half-width, the least value a filled voxel takes and how far beyond the edge sampled
+// values are capped.
+struct InflationFill {
+    double band = 0.0;
+    double depth = -1.0;
+};
+
 class Inflation : public StepDeformation {
   public:
-    // `remove` swaps the map and its inverse: the ball is sucked back into c.
-    Inflation(const Eigen::Vector3d& centre, double radius, const Box& reach, bool remove = false);
+    // `remove` swaps the map and its inverse: the ball is sucked back into c (no ball is
+    // filled then: the inverse reaches every point).
+    Inflation(const Eigen::Vector3d& centre, double radius, const Box& reach, bool remove = false,
+              InflationFill fill = {});
 
     Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const override;
     ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
                               double tolerance = 0.0) const override;
+    double filledValue(const Eigen::Vector3d& x, double value) const override;
+    Box filledBox() const override;
 
   private:
+    double surfaceRadius() const;                           // (rho^3 + s^3)^(1/3)
     Eigen::Vector3d blowUp(const Eigen::Vector3d& p) const; // 2.30
     Eigen::Vector3d suckIn(const Eigen::Vector3d& p) const; // 2.31, c inside the ball
     Eigen::Vector3d c_;
-    double rho3_;
+    double rho_, rho3_;
     bool remove_;
+    InflationFill fill_;
 };
 
 // Sub-steps of several deformations applied one after the other.

@@ -108,6 +108,15 @@ class StepDeformation {
         return Eigen::Vector3d::Zero();
     }
 
+    // Whether the deformation fills a region that has no pre-image but one point with clay of
+    // its own (an inflation's ball, inflate.h; such a deformation has one sub-step). Then the
+    // value sampled at x, at its pre-image, becomes filledValue(x, value): a distance to the
+    // new surface rather than one value across the region. filledBox() holds every point
+    // where filledValue differs from the value it is given.
+    bool fills() const { return fills_; }
+    virtual double filledValue(const Eigen::Vector3d& /*x*/, double value) const { return value; }
+    virtual Box filledBox() const { return {}; }
+
     double forwardTolerance() const { return forwardTolerance_; }
 
     // A bound on how far the whole inverse map spreads points apart, as advection measures it
@@ -156,6 +165,7 @@ class StepDeformation {
     double forwardTolerance_ = 1e-12;
     int forwardMaxIterations_ = 500;
     bool tears_ = false;
+    bool fills_ = false;
 };
 
 } // namespace sweepers

@@ -387,10 +387,14 @@ using ResampleScratches = tbb::enumerable_thread_specific<ResampleScratch>;
 // resolves, so it reads material next to the set where the shape has none, and the tear,
 // which stretches the space around the set by orders of magnitude, would spread that over
 // the rim of the hole.
+//
+// A deformation that fills what has no pre-image (`seg` with fills(): an inflation's ball)
+// turns the value sampled there into its filled value. `seg` is the deformation when it
+// tears or fills, else null.
 template <typename Map>
 std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const SampleSource& source,
                      bool sourceIsGrid, const openvdb::CoordBBox& box, const Map& map,
-                     const StepDeformation* tearing, double tornWindow, Sampling sampling,
+                     const StepDeformation* seg, double tornWindow, Sampling sampling,
                      Changes changes, Interrupter* interrupter, ResampleScratches& scratch,
                      const openvdb::MaskTree* only = nullptr, Staged* staged = nullptr,
                      VoxelValues* gradientBefore = nullptr) {
@@ -399,6 +403,9 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     std::vector<leafwords::Words> changedWords(leaves.size()), movedWords(leaves.size());
     std::atomic<std::size_t> count{0};
     const VoxelPlacement place(grid.transform());
+    const StepDeformation* tearing = seg && seg->tears() ? seg : nullptr;
+    const StepDeformation* filling = seg && seg->fills() ? seg : nullptr;
+    const Box filledBox = filling ? filling->filledBox() : Box();
     const bool windowPastRim = tearing && tearing->windowPastRim();
     const double h = grid.voxelSize()[0];
     const float reach = float(kCorrectedReach * h), seedReach = float(kSeedValues * h);
@@ -448,6 +455,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                 const float old = values[pos];
                 float v = old;
                 float slope[3] = {std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f};
+                bool madeDistance = false; // by the fill of what has no pre-image
                 if (y != x || !sourceIsGrid) {
                     const auto sample = [&](const Eigen::Vector3d& at, float* slopeAt = nullptr) {
                         const openvdb::Vec3d p = place.toIndex(toVdb(at));
@@ -482,8 +490,16 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                         v = std::max(v, float(tearing->leastValue(y))) +
                             float(std::max(0.0, depth));
                     }
+                    if (filling && filledBox.contains(x)) {
+                        const float filled = float(filling->filledValue(x, v));
+                        madeDistance = filled != v;
+                        v = filled;
+                    }
                 }
-                if (gradientBefore && std::abs(v) < seedReach) {
+                if (madeDistance && gradientBefore && std::abs(v) < seedReach) {
+                    // A filled value is a distance already: no stretch to divide it by.
+                    (*gradientBefore)[l].values[std::size_t(pos)] = 1.0f;
+                } else if (gradientBefore && std::abs(v) < seedReach) {
                     // The source's central differences at the pre-image (renormalize()): from
                     // the sample's own reads, or, for a voxel that kept its value, its
                     // neighbours'.
@@ -526,28 +542,14 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     return count;
 }
 
-// Adds to `mask` (each leaf once) what a tearing deformation needs sampled beyond the band
-// grown around the images of the surface: the inside voxels of the opened region (their sign
-// changes), and the voxels near the opening's rim whose value will lie within `shell` of the
-// surface. Where the surface touched the torn set, the rim is new surface, and the images of
-// the few voxels near the touching point only reach it in their own directions; around the
-// rim the tear stretches space along it by (d + r) / d at distance d from the torn set, and
-// past a stretch of 7 (d < r / 6, less than r / 6 beyond the rim) the images of neighbouring
-// voxels land farther apart than the band's dilation closes.
-std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shell,
-                       VoxelList& mask) {
-    const double beyond = shell + seg.opening() / 6.0; // how far past the rim to look
-    const openvdb::CoordBBox box = indexBox(grid, seg.openedBox().expanded(beyond), 1);
+// Adds to `mask` (each leaf once) the inactive voxels of `box` for which
+// needed(x, v, acc) holds (x the voxel's centre, v its value, acc reading the grid), and
+// gives their count.
+template <typename Needed>
+std::size_t markInactive(const Grid& grid, const openvdb::CoordBBox& box, const Needed& needed,
+                         VoxelList& mask) {
     if (box.empty()) return 0;
     const SampleSource source(grid, Grid::create()); // the grid itself, nothing copied
-    // Whether inactive voxel x (value v) is to be sampled.
-    const auto needed = [&](const Eigen::Vector3d& x, float v, const SampleSource::Accessor& acc) {
-        const double depth = seg.openedDepth(x);
-        if (depth > 0.0 && v < 0.0f) return true;
-        if (depth > shell || depth < -beyond) return false;
-        const Eigen::Vector3d p = seg.inverseMap(x);
-        return acc.trilinear(grid.worldToIndex(toVdb(p))) + std::max(0.0, depth) < shell;
-    };
     tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> found;
     const tbb::blocked_range<int> slabs(box.min().x(), box.max().x() + 1);
     parallelFor(slabs, [&](const auto& r) {
@@ -564,17 +566,55 @@ std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shel
                 }
     });
     std::size_t count = 0;
-    openvdb::MaskTree opened;
-    openvdb::tree::ValueAccessor<openvdb::MaskTree, false> macc(opened);
+    openvdb::MaskTree marked;
+    openvdb::tree::ValueAccessor<openvdb::MaskTree, false> macc(marked);
     for (const auto& f : found) {
         for (const openvdb::Coord& c : f)
             macc.setValueOn(c);
         count += f.size();
     }
-    const VoxelList listed = listLeaves(opened);
+    const VoxelList listed = listLeaves(marked);
     mask.insert(mask.end(), listed.begin(), listed.end());
     mask = eachLeafOnce(std::move(mask)); // switching the band on wants each leaf once
     return count;
+}
+
+// Adds to `mask` (each leaf once) what a tearing deformation needs sampled beyond the band
+// grown around the images of the surface: the inside voxels of the opened region (their sign
+// changes), and the voxels near the opening's rim whose value will lie within `shell` of the
+// surface. Where the surface touched the torn set, the rim is new surface, and the images of
+// the few voxels near the touching point only reach it in their own directions; around the
+// rim the tear stretches space along it by (d + r) / d at distance d from the torn set, and
+// past a stretch of 7 (d < r / 6, less than r / 6 beyond the rim) the images of neighbouring
+// voxels land farther apart than the band's dilation closes.
+std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shell,
+                       VoxelList& mask) {
+    const double beyond = shell + seg.opening() / 6.0; // how far past the rim to look
+    const openvdb::CoordBBox box = indexBox(grid, seg.openedBox().expanded(beyond), 1);
+    const auto needed = [&](const Eigen::Vector3d& x, float v, const SampleSource::Accessor& acc) {
+        const double depth = seg.openedDepth(x);
+        if (depth > 0.0 && v < 0.0f) return true;
+        if (depth > shell || depth < -beyond) return false;
+        const Eigen::Vector3d p = seg.inverseMap(x);
+        return acc.trilinear(grid.worldToIndex(toVdb(p))) + std::max(0.0, depth) < shell;
+    };
+    return markInactive(grid, box, needed, mask);
+}
+
+// Adds to `mask` (each leaf once) what a filling deformation needs sampled beyond the band
+// grown around the images of the surface: no surface maps into the region it fills, whose
+// edge may be new surface. The voxels there whose filled value lies within `shell` of the
+// surface join the band; they enclose the rest of the region, whose signs the flood after
+// sampling re-derives.
+std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shell,
+                       VoxelList& mask) {
+    const openvdb::CoordBBox box = indexBox(grid, seg.filledBox(), 1);
+    const auto needed = [&](const Eigen::Vector3d& x, float, const SampleSource::Accessor& acc) {
+        const double at = acc.trilinear(grid.worldToIndex(toVdb(seg.inverseMap(x))));
+        const double filled = seg.filledValue(x, at);
+        return filled != at && std::abs(filled) < shell;
+    };
+    return markInactive(grid, box, needed, mask);
 }
 
 // Whether sampling reached every voxel renormalization seeds from and every voxel their
@@ -1121,6 +1161,8 @@ void SegmentAdvector::Work::growBand() {
     // middle of the opening, so the inside voxels there join the band to be sampled
     // (renormalization drops them again, with their new sign).
     if (seg->tears()) stats.tornVoxels = markOpened(*grid, *seg, (halfWidth + 2) * h, mask);
+    // An inflation fills its ball: no image of the surface reaches its edge either.
+    if (seg->fills()) stats.filledVoxels = markFilled(*grid, *seg, (halfWidth + 2) * h, mask);
     fresh = switchOn(mask);
 }
 
@@ -1177,7 +1219,7 @@ void SegmentAdvector::Work::sample() {
     if (widened) copyFar(sampled);
     moving = movingOf(sampled);
     touched = changedRegion(*grid, *seg);
-    const StepDeformation* tearing = seg->tears() ? seg : nullptr;
+    const StepDeformation* tearsOrFills = seg->tears() || seg->fills() ? seg : nullptr;
     if (options->resampleEachSubStep) {
         // Each sub-step reads what the one before wrote, inactive values included, so their
         // signs are re-derived before it reads them: otherwise a pre-image beyond the band
@@ -1191,7 +1233,7 @@ void SegmentAdvector::Work::sample() {
                     for (std::size_t i = 0; i < n; ++i)
                         y[i] = seg->inverseStep(k, x[i]);
                 },
-                tearing, tornWindow, options->sampling, changes(), options->interrupter,
+                tearsOrFills, tornWindow, options->sampling, changes(), options->interrupter,
                 resampling);
             from->freeCopies();
         }
@@ -1206,7 +1248,7 @@ void SegmentAdvector::Work::sample() {
         widened ? std::make_shared<SampleSource>(*grid, widened) : SampleSource::live(*grid);
     if (!widened) staged.reserve(moving.size(), growths);
     stats.sampledVoxels =
-        resample(*grid, moving, *from, !widened, region, map, tearing, tornWindow,
+        resample(*grid, moving, *from, !widened, region, map, tearsOrFills, tornWindow,
                  options->sampling, changes(), options->interrupter, resampling, nullptr,
                  widened ? nullptr : &staged, dividesByStretch() ? &gradientBefore : nullptr);
     if (!widened) {
@@ -1244,7 +1286,7 @@ void SegmentAdvector::Work::sample() {
         }
         moving.insert(moving.end(), movingGrown.begin(), movingGrown.end());
         stats.sampledVoxels +=
-            resample(*grid, moving, *from, !widened, region, map, tearing, tornWindow,
+            resample(*grid, moving, *from, !widened, region, map, tearsOrFills, tornWindow,
                      options->sampling, changes(), options->interrupter, resampling, &addedTree);
         sampled = std::move(all);
     }

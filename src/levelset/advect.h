@@ -70,6 +70,7 @@ struct AdvectStats {
     std::size_t leavesWidened = 0; // of those, whose band a stretch asked to be widened
     std::size_t leavesFlooded = 0; // whose inactive signs were re-derived
     std::size_t tornVoxels = 0;    // inside voxels beyond the band that a tear opened
+    std::size_t filledVoxels = 0;  // voxels beyond the band an inflation's filled ball reached
     double growSeconds = 0.0, sampleSeconds = 0.0, renormalizeSeconds = 0.0;
     // Each phase of SegmentAdvector, in the order of kAdvectPhases (the first four make band
     // growth, the next two sampling, the seventh renormalization): its wall time, and the

@@ -31,6 +31,7 @@ ExactReference::ExactReference(StartFunction start) : start_(std::move(start)) {
 
 void ExactReference::append(std::shared_ptr<const StepDeformation> deformation) {
     if (!deformation) throw std::invalid_argument("ExactReference::append: no deformation");
+    fills_ = fills_ || deformation->fills();
     history_.push_back(std::move(deformation));
 }
 
@@ -43,15 +44,31 @@ Eigen::Vector3d ExactReference::pullBack(const Eigen::Vector3d& x) const {
 }
 
 double ExactReference::value(const Eigen::Vector3d& x) const {
-    // A deformation that tears space adds, at the point it is given, how deep that point
-    // lies in what it opened (tear.h).
+    // Each deformation turns the value found at a point's pre-image into the point's value: the
+    // same value, except where it tears space (it adds how deep the point lies in what it
+    // opened, tear.h) or fills it (an inflation's ball, inflate.h). Those are applied from the
+    // first deformation on, once the start's value is known; tears alone only add up.
     Eigen::Vector3d p = x;
-    double opened = 0.0;
+    if (!fills_) {
+        double opened = 0.0;
+        for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
+            if ((*it)->tears()) opened += std::max(0.0, (*it)->openedDepth(p));
+            p = (*it)->inverseMap(p);
+        }
+        return start_(p) + opened;
+    }
+    std::vector<std::pair<const StepDeformation*, Eigen::Vector3d>> turns; // latest first
     for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
-        if ((*it)->tears()) opened += std::max(0.0, (*it)->openedDepth(p));
+        if ((*it)->tears() || (*it)->fills()) turns.emplace_back(it->get(), p);
         p = (*it)->inverseMap(p);
     }
-    return start_(p) + opened;
+    double v = start_(p);
+    for (auto it = turns.rbegin(); it != turns.rend(); ++it) {
+        const auto& [seg, at] = *it;
+        if (seg->tears()) v += std::max(0.0, seg->openedDepth(at));
+        if (seg->fills()) v = seg->filledValue(at, v);
+    }
+    return v;
 }
 
 std::optional<Eigen::Vector3d> ExactReference::crossing(const Eigen::Vector3d& a,

@@ -48,6 +48,7 @@ class ExactReference {
   private:
     StartFunction start_;
     std::vector<std::shared_ptr<const StepDeformation>> history_;
+    bool fills_ = false; // whether a deformation of the history fills a region
 };
 
 } // namespace sweepers

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include "deform/inflate.h"
 #include "deform/sweep.h"
 #include "io/stroke_script.h"
 #include "levelset/create.h"
@@ -154,4 +155,27 @@ TEST(ExactReference, TheStudysMeasureOfAnExactDistanceIsItsLinearReadingsFloor) 
     EXPECT_GT(sixteen, 0.003);
     EXPECT_LT(sixteen, 0.0036);
     EXPECT_NEAR(thirtyTwo / sixteen, 0.5, 0.05);
+}
+
+// The exact reference fills an inflation's ball as the engine does (inflate.h): a centre on
+// the sphere or within the band inside it (as the stroke plans it) gives a ball of clay, its
+// value the distance to the sphere of radius (rho^3 + s^3)^(1/3) down to minus the band; a
+// centre deeper inside gives the thesis's value, the centre's, throughout. Just beyond the
+// edge above the sphere lies empty space.
+TEST(ExactReference, AnInflationOnTheSurfaceFillsItsBallWithClay) {
+    const double rho = 0.3, band = 3.0 / 64;
+    const Box everywhere(Eigen::Vector3d::Constant(-3), Eigen::Vector3d::Constant(3));
+    const Eigen::Vector3d c(0, 1, 0);
+    for (const double depth : {0.0, 0.02, 0.1}) {
+        ExactReference ref(ExactReference::sphere(Eigen::Vector3d(0, depth, 0), 1.0));
+        const InflationFill fill{band, depth < band ? depth : -1.0};
+        ref.append(std::make_shared<Inflation>(c, rho, everywhere, false, fill));
+        const double edge = std::cbrt(rho * rho * rho + depth * depth * depth);
+        for (const double r : {0.2, 0.5, 0.9}) {
+            const Eigen::Vector3d p = c + r * rho * Eigen::Vector3d(0.6, 0.8, 0);
+            const double want = depth < band ? std::max(r * rho - edge, -band) : -depth;
+            EXPECT_NEAR(ref.value(p), want, 1e-12) << depth << " " << r;
+        }
+        EXPECT_GT(ref.value(c + 1.02 * rho * Eigen::Vector3d::UnitY()), 0.0) << depth;
+    }
 }
