@@ -11,10 +11,10 @@ Inflation::Inflation(const Eigen::Vector3d& centre, double radius, const Box& re
     : c_(centre), rho_(radius), rho3_(radius * radius * radius), remove_(remove), fill_(fill) {
     if (!(radius > 0.0) || !std::isfinite(radius))
         throw std::invalid_argument("an inflation needs a positive radius");
-    if (!(fill.band >= 0.0) || !std::isfinite(fill.band) || !std::isfinite(fill.depth))
-        throw std::invalid_argument("an inflation's fill needs a finite band and depth");
+    if (!(fill.band >= 0.0) || !std::isfinite(fill.band))
+        throw std::invalid_argument("an inflation's fill needs a band of at least 0");
     steps_ = 1;
-    fills_ = !remove && fill.band > 0.0 && fill.depth >= 0.0;
+    fills_ = !remove && fill.band > 0.0;
     affected_ = reach;
     affected_.add(Box(centre.array() - 2 * radius, centre.array() + 2 * radius));
 }
@@ -44,21 +44,19 @@ ForwardResult Inflation::forwardStep(int, const Eigen::Vector3d& q, double) cons
     return {remove_ ? suckIn(q) : blowUp(q), true, 1};
 }
 
-double Inflation::surfaceRadius() const {
-    const double s = fill_.depth;
-    return std::cbrt(rho3_ + s * s * s);
-}
-
-double Inflation::filledValue(const Eigen::Vector3d& x, double value) const {
-    if (!fills_) return value;
-    const double r = (x - c_).norm(), out = r - surfaceRadius();
-    if (r < rho_) return std::max(out, -fill_.band); // the new ball: clay
-    return value > 0.0 && out > 0.0 && out < fill_.band ? std::min(value, out) : value;
+double Inflation::filledValue(const Eigen::Vector3d& x, double value, double fromValue) const {
+    const double band = fill_.band;
+    // Deeper than half the band, the thesis's ball meets the pushed surface well enough.
+    if (!fills_ || fromValue <= -0.5 * band || fromValue >= band) return value;
+    const double s = std::max(0.0, -fromValue);
+    const double r = (x - c_).norm(), out = r - std::cbrt(rho3_ + s * s * s);
+    if (r < rho_) return std::max(out, -band); // the new ball: clay
+    return value > 0.0 && out > 0.0 && out < band ? std::min(value, out) : value;
 }
 
 Box Inflation::filledBox() const {
     if (!fills_) return {};
-    const double r = surfaceRadius() + fill_.band;
+    const double band = fill_.band, r = std::cbrt(rho3_ + band * band * band) + band;
     return Box(c_.array() - r, c_.array() + r);
 }
 

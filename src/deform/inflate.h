@@ -15,13 +15,14 @@
 // as a razor). For a centre at depth s inside, the new surface lies about s^3 / (3 rho^2)
 // beyond the ball's edge, where the inverse squeezes a whole band into the centre's
 // neighbourhood (its stretch grows without bound), and the values sampled there are no
-// distances. So an inflation whose centre lies within the band (where the grid knows s) fills
-// its ball (InflationFill): the value inside is the distance to the sphere of radius
+// distances. So an inflation whose centre's value (as the grid holds it when the inflation
+// comes) lies within the band outside the surface or half of it inside fills its ball
+// (InflationFill): the value inside is the distance to the sphere of radius
 // (rho^3 + s^3)^(1/3) about c, which the new surface encloses and touches where the old
-// surface is nearest (a small fraction of a voxel from the edge, for s within the band), and
-// a value sampled just beyond the edge outside the shape is capped by the distance to that
-// sphere, no smaller than the distance to the new surface. The stroke first puts a centre
-// just outside the surface, within the band, on the surface along the normal
+// surface is nearest (a small fraction of a voxel from the edge), and a value sampled just
+// beyond the edge outside the shape is capped by the distance to that sphere, no smaller than
+// the distance to the new surface. Deeper centres keep the thesis's value. The stroke first
+// puts a centre just outside the surface, within the band, on the surface along the normal
 // (sculpt/stroke.cpp).
 //
 #pragma once
@@ -34,13 +35,11 @@
 
 namespace sweepers {
 
-// How an inflation fills its new ball: `depth`, the centre's distance inside the surface (0
-// on it; negative: no fill, the thesis's value at c everywhere in the ball), and `band`, the
-// grid's half-width, the least value a filled voxel takes and how far beyond the edge sampled
-// values are capped.
+// How an inflation fills its new ball: `band`, the grid's half-width (where its values are
+// distances), the least value a filled voxel takes and how far beyond the edge sampled
+// values are capped. 0: never (the thesis's value at c everywhere in the ball).
 struct InflationFill {
     double band = 0.0;
-    double depth = -1.0;
 };
 
 class Inflation : public StepDeformation {
@@ -53,11 +52,11 @@ class Inflation : public StepDeformation {
     Eigen::Vector3d inverseStep(int k, const Eigen::Vector3d& p) const override;
     ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
                               double tolerance = 0.0) const override;
-    double filledValue(const Eigen::Vector3d& x, double value) const override;
+    Eigen::Vector3d filledFrom() const override { return c_; }
+    double filledValue(const Eigen::Vector3d& x, double value, double fromValue) const override;
     Box filledBox() const override;
 
   private:
-    double surfaceRadius() const;                           // (rho^3 + s^3)^(1/3)
     Eigen::Vector3d blowUp(const Eigen::Vector3d& p) const; // 2.30
     Eigen::Vector3d suckIn(const Eigen::Vector3d& p) const; // 2.31, c inside the ball
     Eigen::Vector3d c_;

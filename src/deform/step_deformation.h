@@ -108,13 +108,18 @@ class StepDeformation {
         return Eigen::Vector3d::Zero();
     }
 
-    // Whether the deformation fills a region that has no pre-image but one point with clay of
-    // its own (an inflation's ball, inflate.h; such a deformation has one sub-step). Then the
-    // value sampled at x, at its pre-image, becomes filledValue(x, value): a distance to the
-    // new surface rather than one value across the region. filledBox() holds every point
-    // where filledValue differs from the value it is given.
+    // Whether the deformation fills a region that has no pre-image but one point,
+    // filledFrom(), with clay of its own (an inflation's ball, inflate.h; such a deformation
+    // has one sub-step). Then the value sampled at x, at its pre-image, becomes
+    // filledValue(x, value, fromValue), fromValue the value at filledFrom() before the
+    // deformation: a distance to the new surface rather than one value across the region.
+    // filledBox() holds every point where filledValue differs from the value it is given.
     bool fills() const { return fills_; }
-    virtual double filledValue(const Eigen::Vector3d& /*x*/, double value) const { return value; }
+    virtual Eigen::Vector3d filledFrom() const { return Eigen::Vector3d::Zero(); }
+    virtual double filledValue(const Eigen::Vector3d& /*x*/, double value,
+                               double /*fromValue*/) const {
+        return value;
+    }
     virtual Box filledBox() const { return {}; }
 
     double forwardTolerance() const { return forwardTolerance_; }

@@ -406,6 +406,16 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     const StepDeformation* tearing = seg && seg->tears() ? seg : nullptr;
     const StepDeformation* filling = seg && seg->fills() ? seg : nullptr;
     const Box filledBox = filling ? filling->filledBox() : Box();
+    // The value the filled region is made from, sampled as every voxel is.
+    double fromValue = 0.0;
+    if (filling) {
+        const SampleSource::Accessor acc(source);
+        const openvdb::Vec3d p = place.toIndex(toVdb(filling->filledFrom()));
+        const float reach = float(kCorrectedReach * grid.voxelSize()[0]);
+        fromValue = sampling == Sampling::MonotoneCubic ? sampleMonotoneCubic(acc, p)
+                    : sampling == Sampling::Corrected   ? acc.corrected(p, reach)
+                                                        : acc.trilinear(p);
+    }
     const bool windowPastRim = tearing && tearing->windowPastRim();
     const double h = grid.voxelSize()[0];
     const float reach = float(kCorrectedReach * h), seedReach = float(kSeedValues * h);
@@ -491,7 +501,7 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
                             float(std::max(0.0, depth));
                     }
                     if (filling && filledBox.contains(x)) {
-                        const float filled = float(filling->filledValue(x, v));
+                        const float filled = float(filling->filledValue(x, v, fromValue));
                         madeDistance = filled != v;
                         v = filled;
                     }
@@ -609,9 +619,12 @@ std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shel
 std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shell,
                        VoxelList& mask) {
     const openvdb::CoordBBox box = indexBox(grid, seg.filledBox(), 1);
+    const SampleSource source(grid, Grid::create());
+    const double from =
+        SampleSource::Accessor(source).trilinear(grid.worldToIndex(toVdb(seg.filledFrom())));
     const auto needed = [&](const Eigen::Vector3d& x, float, const SampleSource::Accessor& acc) {
         const double at = acc.trilinear(grid.worldToIndex(toVdb(seg.inverseMap(x))));
-        const double filled = seg.filledValue(x, at);
+        const double filled = seg.filledValue(x, at, from);
         return filled != at && std::abs(filled) < shell;
     };
     return markInactive(grid, box, needed, mask);

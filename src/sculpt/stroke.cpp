@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <stdexcept>
-#include <utility>
 
 #include <openvdb/tools/Interpolation.h>
 
@@ -14,13 +13,10 @@ namespace sweepers {
 
 namespace {
 
-// Where an inflation planned at `centre` is centred, and how it fills its ball
-// (inflate.h says why). A centre just outside the surface, within the band, moves onto the
-// surface along the normal (a few Newton steps on the distance the grid holds); a centre
-// farther out keeps the thesis's ball. A centre inside within the band fills its ball: there
-// the new surface lies a small fraction of a voxel beyond the ball's edge all round it.
-std::pair<Eigen::Vector3d, InflationFill> placeInflation(const Grid& grid,
-                                                         const Eigen::Vector3d& centre) {
+// Where an inflation planned at `centre` is centred (inflate.h says why): a centre just
+// outside the surface, within the band, moves onto the surface along the normal (a few Newton
+// steps on the distance the grid holds); any other is kept.
+Eigen::Vector3d ontoSurface(const Grid& grid, const Eigen::Vector3d& centre) {
     const double h = grid.voxelSize()[0], band = halfWidthOf(grid) * h;
     const Grid::ConstAccessor acc = grid.getConstAccessor();
     const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sample(
@@ -28,7 +24,7 @@ std::pair<Eigen::Vector3d, InflationFill> placeInflation(const Grid& grid,
     const auto at = [&](const Eigen::Vector3d& p) { return double(sample.wsSample(toVdb(p))); };
     Eigen::Vector3d c = centre;
     double d = at(c);
-    if (d >= 0.999 * band) return {c, InflationFill{band, -1.0}};
+    if (d >= 0.999 * band) return c;
     for (int step = 0; step < 4 && d > 0.0; ++step) {
         Eigen::Vector3d g;
         for (int a = 0; a < 3; ++a) {
@@ -39,7 +35,7 @@ std::pair<Eigen::Vector3d, InflationFill> placeInflation(const Grid& grid,
         c -= d / g.squaredNorm() * g;
         d = at(c);
     }
-    return {c, InflationFill{band, d > -0.999 * band ? std::max(0.0, -d) : -1.0}};
+    return c;
 }
 
 template <class... F> struct Overloaded : F... { using F::operator()...; };
@@ -220,14 +216,11 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                 // by its ball, which the later copies' reach takes in.
                 const double rho = s.strength * s.radius;
                 const Box around = reach().expanded(2.0 * rho * (s.radial.count - 1));
+                const InflationFill fill{halfWidthOf(grid) * grid.voxelSize()[0]};
                 for (int k = 0; k < s.radial.count; ++k) {
                     const Eigen::Vector3d at = s.radial.turn(k) * s.at;
-                    if (s.remove) {
-                        parts.push_back(std::make_unique<Inflation>(at, rho, around, true));
-                        continue;
-                    }
-                    const auto [c, fill] = placeInflation(grid, at);
-                    parts.push_back(std::make_unique<Inflation>(c, rho, around, false, fill));
+                    parts.push_back(std::make_unique<Inflation>(
+                        s.remove ? at : ontoSurface(grid, at), rho, around, s.remove, fill));
                 }
             },
             [&](const PinchStroke& s) { parts = planPinch(s, grid.voxelSize()[0]); },

@@ -44,29 +44,36 @@ Eigen::Vector3d ExactReference::pullBack(const Eigen::Vector3d& x) const {
 }
 
 double ExactReference::value(const Eigen::Vector3d& x) const {
+    return valueThrough(history_.size(), x);
+}
+
+double ExactReference::valueThrough(std::size_t n, const Eigen::Vector3d& x) const {
     // Each deformation turns the value found at a point's pre-image into the point's value: the
     // same value, except where it tears space (it adds how deep the point lies in what it
-    // opened, tear.h) or fills it (an inflation's ball, inflate.h). Those are applied from the
-    // first deformation on, once the start's value is known; tears alone only add up.
+    // opened, tear.h) or fills it (an inflation's ball, from the value its centre had before
+    // it: inflate.h). Those are applied from the first deformation on, once the start's value
+    // is known; tears alone only add up.
     Eigen::Vector3d p = x;
     if (!fills_) {
         double opened = 0.0;
-        for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
-            if ((*it)->tears()) opened += std::max(0.0, (*it)->openedDepth(p));
-            p = (*it)->inverseMap(p);
+        for (std::size_t k = n; k-- > 0;) {
+            if (history_[k]->tears()) opened += std::max(0.0, history_[k]->openedDepth(p));
+            p = history_[k]->inverseMap(p);
         }
         return start_(p) + opened;
     }
-    std::vector<std::pair<const StepDeformation*, Eigen::Vector3d>> turns; // latest first
-    for (auto it = history_.rbegin(); it != history_.rend(); ++it) {
-        if ((*it)->tears() || (*it)->fills()) turns.emplace_back(it->get(), p);
-        p = (*it)->inverseMap(p);
+    std::vector<std::pair<std::size_t, Eigen::Vector3d>> turns; // latest first
+    for (std::size_t k = n; k-- > 0;) {
+        const StepDeformation& seg = *history_[k];
+        if (seg.tears() || (seg.fills() && seg.filledBox().contains(p))) turns.emplace_back(k, p);
+        p = seg.inverseMap(p);
     }
     double v = start_(p);
     for (auto it = turns.rbegin(); it != turns.rend(); ++it) {
-        const auto& [seg, at] = *it;
-        if (seg->tears()) v += std::max(0.0, seg->openedDepth(at));
-        if (seg->fills()) v = seg->filledValue(at, v);
+        const StepDeformation& seg = *history_[it->first];
+        if (seg.tears()) v += std::max(0.0, seg.openedDepth(it->second));
+        if (seg.fills())
+            v = seg.filledValue(it->second, v, valueThrough(it->first, seg.filledFrom()));
     }
     return v;
 }

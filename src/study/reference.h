@@ -46,6 +46,9 @@ class ExactReference {
                                             double tolerance) const;
 
   private:
+    // phi_ref(x) of the first n deformations of the history.
+    double valueThrough(std::size_t n, const Eigen::Vector3d& x) const;
+
     StartFunction start_;
     std::vector<std::shared_ptr<const StepDeformation>> history_;
     bool fills_ = false; // whether a deformation of the history fills a region

@@ -158,18 +158,21 @@ TEST(ExactReference, TheStudysMeasureOfAnExactDistanceIsItsLinearReadingsFloor) 
 }
 
 // The exact reference fills an inflation's ball as the engine does (inflate.h): a centre on
-// the sphere or within the band inside it (as the stroke plans it) gives a ball of clay, its
-// value the distance to the sphere of radius (rho^3 + s^3)^(1/3) down to minus the band; a
-// centre deeper inside gives the thesis's value, the centre's, throughout. Just beyond the
-// edge above the sphere lies empty space.
+// the sphere or within the band inside it gives a ball of clay, its value the distance to the
+// sphere of radius (rho^3 + s^3)^(1/3) down to minus the band, s the centre's depth before
+// the inflation (here the second of two, the first far below); a centre deeper inside gives
+// the thesis's value, the centre's, throughout. Just beyond the edge above the sphere lies
+// empty space.
 TEST(ExactReference, AnInflationOnTheSurfaceFillsItsBallWithClay) {
     const double rho = 0.3, band = 3.0 / 64;
     const Box everywhere(Eigen::Vector3d::Constant(-3), Eigen::Vector3d::Constant(3));
+    const Box below(Eigen::Vector3d::Constant(-6), Eigen::Vector3d(6, -4, 6));
     const Eigen::Vector3d c(0, 1, 0);
     for (const double depth : {0.0, 0.02, 0.1}) {
         ExactReference ref(ExactReference::sphere(Eigen::Vector3d(0, depth, 0), 1.0));
-        const InflationFill fill{band, depth < band ? depth : -1.0};
-        ref.append(std::make_shared<Inflation>(c, rho, everywhere, false, fill));
+        ref.append(std::make_shared<Inflation>(Eigen::Vector3d(0, -5, 0), 0.1, below, false,
+                                               InflationFill{band}));
+        ref.append(std::make_shared<Inflation>(c, rho, everywhere, false, InflationFill{band}));
         const double edge = std::cbrt(rho * rho * rho + depth * depth * depth);
         for (const double r : {0.2, 0.5, 0.9}) {
             const Eigen::Vector3d p = c + r * rho * Eigen::Vector3d(0.6, 0.8, 0);
