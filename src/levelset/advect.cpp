@@ -776,9 +776,11 @@ widening(const std::vector<const LeafNode*>& leaves, const std::vector<openvdb::
 
 openvdb::CoordBBox changedRegion(const Grid& grid, const StepDeformation& seg) {
     // The sampled region, and the band activated around images of the interface (which
-    // stay inside the affected box: the deformation maps it onto itself).
+    // stay inside the affected box: the deformation maps it onto itself), and what
+    // renormalization writes: within half-width + 1 of a changed voxel, and one step past
+    // that, where the band may grow.
     openvdb::CoordBBox box = indexBox(grid, seg.affectedBox(), 1);
-    box.expand(int(std::ceil(halfWidthOf(grid))) + 1);
+    box.expand(int(std::ceil(halfWidthOf(grid))) + 2);
     return box;
 }
 
