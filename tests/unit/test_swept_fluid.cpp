@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -290,13 +291,26 @@ TEST(SweptFluid, ScriptsReadAndWriteFluidStrokesAndRefuseBadOnes) {
         std::string::npos);
 }
 
+// SWEEPERS_CACHE pointed at a fresh directory of its own while it lives, then as it was.
+struct FreshCache {
+    explicit FreshCache(const std::string& name) : dir(::testing::TempDir() + "/" + name) {
+        std::filesystem::remove_all(dir);
+        if (const char* v = std::getenv("SWEEPERS_CACHE")) had = v;
+        ::setenv("SWEEPERS_CACHE", dir.c_str(), 1);
+    }
+    ~FreshCache() {
+        if (had)
+            ::setenv("SWEEPERS_CACHE", had->c_str(), 1);
+        else
+            ::unsetenv("SWEEPERS_CACHE");
+    }
+    std::string dir;
+    std::optional<std::string> had;
+};
+
 TEST(SweptFluid, TheCacheKeepsTheSolutionAndSurvivesDamageAndReadOnlyPlaces) {
     // Small grids, each its own solution (and cache file).
-    const std::string dir = ::testing::TempDir() + "/fluid_cache_test";
-    std::filesystem::remove_all(dir);
-    const char* had = std::getenv("SWEEPERS_CACHE");
-    const std::string old = had ? had : "";
-    ::setenv("SWEEPERS_CACHE", dir.c_str(), 1);
+    const FreshCache cache("fluid_cache_test");
     FluidSpec a;
     a.cells = 16;
     a.ballRadius = 4;
@@ -330,21 +344,13 @@ TEST(SweptFluid, TheCacheKeepsTheSolutionAndSurvivesDamageAndReadOnlyPlaces) {
     ASSERT_TRUE(third);
     EXPECT_GT(third->centerSpeed, 0.1);
     EXPECT_NE(said.find("could not keep it"), std::string::npos) << said;
-    if (had)
-        ::setenv("SWEEPERS_CACHE", old.c_str(), 1);
-    else
-        ::unsetenv("SWEEPERS_CACHE");
 }
 
 // The swept fluid made by the run that solves it and by the runs that read it from the cache
 // is the same field: the same lattice, the same samples, to the bit, so a fluid stroke
 // sculpts the same grid either way (a solver of few cells, so that it solves in a moment).
 TEST(SweptFluid, TheRunThatSolvesItAndTheRunsThatReadItSculptTheSameGrid) {
-    const std::string dir = ::testing::TempDir() + "/fluid_lattice_test";
-    std::filesystem::remove_all(dir);
-    const char* had = std::getenv("SWEEPERS_CACHE");
-    const std::string old = had ? had : "";
-    ::setenv("SWEEPERS_CACHE", dir.c_str(), 1);
+    const FreshCache cache("fluid_lattice_test");
     FluidSpec spec;
     spec.cells = 24;
     spec.ballRadius = 4;
@@ -373,8 +379,4 @@ TEST(SweptFluid, TheRunThatSolvesItAndTheRunsThatReadItSculptTheSameGrid) {
         grids[k++] = sculptor.gridPtr();
     }
     EXPECT_EQ(sweepers::test::differingBits(*grids[0], *grids[1]), 0u);
-    if (had)
-        ::setenv("SWEEPERS_CACHE", old.c_str(), 1);
-    else
-        ::unsetenv("SWEEPERS_CACHE");
 }
