@@ -6,6 +6,8 @@
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/MeshToVolume.h>
 
+#include "levelset/fast_marching.h"
+
 namespace sweepers {
 
 void initVdb() {
@@ -57,6 +59,11 @@ GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
     // OpenVDB returns what it had when interrupted: not a level set to keep.
     pollInterrupt(interrupter);
     markAsDocument(*g);
+    // OpenVDB's band misses voxels up to a voxel inside its edge (its closing smoothing
+    // raises distances near the edges between triangles past the half-width, and its
+    // expansion leaves gaps without it): marched again from the surface, it holds every voxel
+    // nearer the surface than its edge, as a sculpted band does.
+    renormalizeAll(*g, FmmOrder::Second, interrupter);
     return g;
 }
 

@@ -135,3 +135,19 @@ TEST(MeshFile, MeshStartBecomesALevelSet) {
     EXPECT_NEAR(openvdb::tools::levelSetVolume(*back), openvdb::tools::levelSetVolume(*g),
                 0.01 * openvdb::tools::levelSetVolume(*g));
 }
+
+// A box of twelve triangles (the random histories' mesh start): OpenVDB's band left 258
+// voxels up to a voxel inside its edge without a neighbour, near the faces' diagonals.
+TEST(MeshFile, MeshStartHoldsItsWholeBand) {
+    std::vector<Eigen::Vector3f> corners;
+    for (int k = 0; k < 8; ++k)
+        corners.emplace_back(k & 1 ? 0.8f : -0.8f, k & 2 ? 0.8f : -0.8f, k & 4 ? 0.8f : -0.8f);
+    const std::vector<Eigen::Vector3i> faces = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6},
+                                                {0, 1, 4}, {1, 5, 4}, {2, 6, 3}, {3, 6, 7},
+                                                {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+    const GridPtr box = levelSetFromMesh(corners, faces, 1.0 / 77, 3);
+    const BandReport band = checkBand(*box);
+    EXPECT_EQ(band.bandHoles, 0u);
+    EXPECT_EQ(band.beyondBand, 0u);
+    EXPECT_NEAR(openvdb::tools::levelSetVolume(*box), 1.6 * 1.6 * 1.6, 0.002);
+}
