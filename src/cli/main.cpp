@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -21,6 +22,8 @@
 #include "cli/command.h"
 #include "cli/progress.h"
 #include "cli/study_command.h"
+#include "core/format.h"
+#include "core/limits.h"
 #include "core/memory.h"
 #include "io/atomic_file.h"
 #include "io/film_files.h"
@@ -62,6 +65,35 @@ json vec(const Eigen::Vector3d& v) {
     return json::array({v.x(), v.y(), v.z()});
 }
 
+// A positive finite number, at most `most`, said in words (CLI11's own range check prints
+// its bounds in seventeen digits).
+CLI::Validator positiveNumber(double most = std::numeric_limits<double>::max()) {
+    return CLI::Validator(
+        [most](std::string& text) -> std::string {
+            double v = 0.0;
+            try {
+                std::size_t used = 0;
+                v = std::stod(text, &used);
+                if (used != text.size()) v = 0.0;
+            } catch (const std::exception&) {
+            }
+            if (v > 0.0 && v <= most) return "";
+            return "must be a positive number" +
+                   (most < std::numeric_limits<double>::max() ? " of at most " + formatNumber(most)
+                                                              : std::string()) +
+                   ", not " + text;
+        },
+        "POSITIVE");
+}
+
+// An error: one line on stderr and, with --json, the same on stdout as {"error": ..., "exit":
+// N}, so that a program reading stdout always gets one object (docs/cli.md).
+int failWith(int code, const std::string& message) {
+    std::cerr << "sweepers-cli: " << message << "\n";
+    if (gOut.json) printJson({{"error", message}, {"exit", code}});
+    return code;
+}
+
 // Fails early, before any long work, when an output cannot be written.
 void requireWritable(const std::string& path) {
     const std::string dir = directoryOf(path);
@@ -98,6 +130,11 @@ int runCheck(const std::string& path) {
                 SwirlSegment(toSwirl(*swirl)), 0.0);
         } else if (std::holds_alternative<InflateStroke>(stroke)) {
             out.push_back({{"stroke", i}, {"type", "inflate"}});
+        } else if (std::holds_alternative<SmoothStroke>(stroke)) {
+            // Not a deformation: each dab relaxes the surface under the ball.
+            out.push_back({{"stroke", i},
+                           {"type", "smooth"},
+                           {"dabs", segmentCount(stroke, script.grid.voxelSize)}});
         } else if (const auto* flow = std::get_if<FlowStroke>(&stroke)) {
             // Without a segment count, the segments are chosen on the shape when applied.
             const auto field = makeField(flow->field);
@@ -153,6 +190,11 @@ int runCheck(const std::string& path) {
     for (const auto& row : out) {
         if (row["type"] == "inflate") {
             std::cout << "  stroke " << row["stroke"] << ": inflate (reaches the whole shape)\n";
+            continue;
+        }
+        if (row["type"] == "smooth") {
+            std::cout << "  stroke " << row["stroke"] << ": smooth, " << row["dabs"]
+                      << " dab(s) of curvature flow under the brush\n";
             continue;
         }
         if (row["type"] == "keyframed at rest") {
@@ -300,10 +342,10 @@ json measuresJson(const Grid& grid) {
               {"components", m.components}}}};
 }
 
-// --voxel-size as given: 0 (not given) or a positive finite number.
-void requireVoxelSizeOption(double h) {
-    if (h != 0.0 && !(h > 0.0 && std::isfinite(h)))
-        throw UsageError("--voxel-size must be a positive number");
+// --voxel-size, when given: a positive finite number (0 is not "not given").
+void requireVoxelSizeOption(double h, bool given) {
+    if (given && !(h > 0.0 && std::isfinite(h)))
+        throw UsageError("--voxel-size must be a positive number, not " + formatNumber(h));
 }
 
 // The surface as exported: y up as the modeler shows it, or turned so that z is up.
@@ -320,13 +362,14 @@ void exportMesh(const Grid& grid, const std::string& path, const std::string& up
 
 struct ApplyArgs {
     std::string script, output, mesh, up = "y";
-    double voxelSize = 0.0;
+    double voxelSize = 0.0; // 0: the script's
+    bool voxelSizeGiven = false;
     bool perSubStep = false, firstOrder = false, stats = false, cubic = false, trilinear = false,
          force = false;
 };
 
 int runApply(const ApplyArgs& a) {
-    requireVoxelSizeOption(a.voxelSize);
+    requireVoxelSizeOption(a.voxelSize, a.voxelSizeGiven);
     const StrokeScript script = readStrokeScript(a.script);
     if (!a.mesh.empty()) requireMeshPath(a.mesh);
     requireWritable(a.output);
@@ -476,10 +519,14 @@ int runRecover(const std::string& where, const std::string& output, const std::s
     return kDone;
 }
 
+// A film's bounds: beyond them a typo (--fps 1e9) would plan more frames than fit in memory.
+constexpr double kMostFps = 1000.0;
+constexpr std::size_t kMostFrames = 1000000;
+
 struct AnimateArgs {
     std::string script, output, mesh, frames, fog, up = "y";
     double fps = 24.0, secondsPerSegment = 0.25, voxelSize = 0.0;
-    bool force = false;
+    bool voxelSizeGiven = false, force = false;
 };
 
 // "A-B" or "A", within 1..count.
@@ -510,7 +557,7 @@ std::pair<std::size_t, std::size_t> parseFrameRange(const std::string& text, std
 // at the same time, frame rate and voxel size is kept, so an edit rewrites only the frames
 // it changes.
 int runAnimate(const AnimateArgs& a) {
-    requireVoxelSizeOption(a.voxelSize);
+    requireVoxelSizeOption(a.voxelSize, a.voxelSizeGiven);
     std::string text; // the script as parsed: what the frames are made of
     const StrokeScript script = readStrokeScript(a.script, &text);
     FilmTiming timing;
@@ -519,6 +566,13 @@ int runAnimate(const AnimateArgs& a) {
     double seconds = 0.0;
     for (const double d : strokeDurations(script, timing))
         seconds += d;
+    if (!(seconds * timing.fps <= double(kMostFrames)))
+        throw UsageError("the film would have " + formatNumber(std::ceil(seconds * timing.fps)) +
+                         " frames (" + formatNumber(seconds) + " s at " + formatNumber(timing.fps) +
+                         " fps); a film has at most " + std::to_string(kMostFrames));
+    if (a.fog == "surface") // the level set's name (markAsDocument)
+        throw UsageError("--fog: '" + a.fog +
+                         "' is the level set's own name; give the fog another");
     const std::size_t count = filmFrameCount(seconds, timing.fps);
     // (Plain variables: lambdas below capture them, which C++17 forbids for bindings.)
     const std::pair<std::size_t, std::size_t> range = parseFrameRange(a.frames, count);
@@ -630,6 +684,18 @@ static int run(int argc, char** argv) {
         on->add_flag("--json", gOut.json, "Print " + what + " as one JSON object on stdout");
     };
     quietFlag(&app);
+    // The limits (core/limits.h), on the program and on each command too.
+    double maxMemoryGb = 0.0, maxWork = 0.0;
+    const auto limitOptions = [&](CLI::App* on) {
+        on->add_option("--max-memory", maxMemoryGb,
+                       "Refuse work estimated to need more memory, in GB (default: half the "
+                       "memory available)")
+            ->check(positiveNumber());
+        on->add_option("--max-work", maxWork,
+                       "Refuse a stroke estimated to take more voxel updates (default 2e9)")
+            ->check(positiveNumber());
+    };
+    limitOptions(&app);
 
     std::string path, output;
     CLI::App* check = app.add_subcommand("check", "Validate a stroke script and show its plan");
@@ -640,9 +706,22 @@ static int run(int argc, char** argv) {
     std::vector<double> center{0, 0, 0};
     CLI::App* create = app.add_subcommand("new", "Write a sphere level set");
     create->add_option("-o,--output", output, "Output .vdb")->required();
-    create->add_option("--radius", radius, "Sphere radius")->check(CLI::PositiveNumber);
-    create->add_option("--center", center, "Sphere centre")->expected(3);
-    create->add_option("--voxel-size", voxelSize, "Voxel size")->check(CLI::PositiveNumber);
+    create->add_option("--radius", radius, "Sphere radius")->check(positiveNumber());
+    create->add_option("--center", center, "Sphere centre")
+        ->expected(3)
+        ->check(CLI::Validator(
+            [](std::string& text) -> std::string {
+                // As a script's numbers (io/stroke_script.cpp): finite, within 1e5.
+                try {
+                    std::size_t used = 0;
+                    const double v = std::stod(text, &used);
+                    if (used == text.size() && std::abs(v) <= 1e5) return "";
+                } catch (const std::exception&) {
+                }
+                return "must be a number within 1e5 of zero, not " + text;
+            },
+            "NUMBER"));
+    create->add_option("--voxel-size", voxelSize, "Voxel size")->check(positiveNumber());
     create->add_option("--half-width", halfWidth, "Band half-width in voxels")
         ->check(CLI::Range(2.0, 64.0));
     bool force = false;
@@ -653,7 +732,8 @@ static int run(int argc, char** argv) {
     CLI::App* apply = app.add_subcommand("apply", "Apply a stroke script and write the result");
     apply->add_option("script", applyArgs.script, "Stroke script (JSON)")->required();
     apply->add_option("-o,--output", applyArgs.output, "Output .vdb")->required();
-    apply->add_option("--voxel-size", applyArgs.voxelSize, "Override the script's voxel size");
+    CLI::Option* applyVoxelSize =
+        apply->add_option("--voxel-size", applyArgs.voxelSize, "Override the script's voxel size");
     apply->add_option("--mesh", applyArgs.mesh, "Also export the surface (.obj, .ply, .stl)");
     apply
         ->add_option("--up", applyArgs.up,
@@ -720,13 +800,13 @@ static int run(int argc, char** argv) {
                      "Frame files, the frame number in place of the '#' run "
                      "(for example frames/shape_####.vdb)")
         ->required();
-    animate->add_option("--fps", animateArgs.fps, "Frames per second (default 24)")
-        ->check(CLI::PositiveNumber);
+    animate->add_option("--fps", animateArgs.fps, "Frames per second (default 24, at most 1000)")
+        ->check(positiveNumber(kMostFps));
     animate
         ->add_option("--seconds-per-segment", animateArgs.secondsPerSegment,
                      "Duration of a path segment of a stroke without a duration "
                      "(default 0.25)")
-        ->check(CLI::PositiveNumber);
+        ->check(positiveNumber());
     animate->add_option("--frames", animateArgs.frames, "Only these frames: A-B or A");
     animate->add_option("--mesh", animateArgs.mesh,
                         "Also a mesh per frame (.ply, .obj or .stl, with a '#' run)");
@@ -737,22 +817,33 @@ static int run(int argc, char** argv) {
                      "Also a fog volume of this name beside the level set (default: density)")
         ->expected(0, 1)
         ->default_str("density");
-    animate->add_option("--voxel-size", animateArgs.voxelSize, "Override the script's voxel size");
+    CLI::Option* animateVoxelSize = animate->add_option("--voxel-size", animateArgs.voxelSize,
+                                                        "Override the script's voxel size");
     jsonFlag(animate, "the frames and files written");
     animate->add_flag("--force", animateArgs.force,
                       "Overwrite frames of another film; build the start even when it seems to "
                       "need more memory than is free");
     animate->add_option("--threads", threads, "Worker threads")->check(CLI::Range(1, 1024));
 
-    for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; }))
+    for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) {
         quietFlag(command);
+        limitOptions(command);
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
         // --help and --version are not errors; anything else CLI11 refuses is a usage error.
         const int code = app.exit(e);
-        return code == 0 ? kDone : kUsage;
+        if (code == 0) return kDone;
+        // (CLI11 stops at the error: --json may lie beyond it.)
+        for (int i = 1; i < argc; ++i)
+            gOut.json = gOut.json || std::string(argv[i]) == "--json";
+        if (gOut.json) printJson({{"error", e.what()}, {"exit", int(kUsage)}});
+        return kUsage;
     }
+    setLimits({maxMemoryGb * 1e9, maxWork});
+    applyArgs.voxelSizeGiven = applyVoxelSize->count() > 0;
+    animateArgs.voxelSizeGiven = animateVoxelSize->count() > 0;
     std::signal(SIGINT, onStopSignal);
     std::signal(SIGTERM, onStopSignal);
     std::unique_ptr<tbb::global_control> limit;
@@ -783,14 +874,12 @@ static int run(int argc, char** argv) {
             return kDone;
         }
     } catch (const Cancelled&) {
-        std::cerr << "sweepers-cli: interrupted; nothing was written\n";
-        return kInterrupted; // the shell's code for a command ended by SIGINT
+        // The shell's code for a command ended by SIGINT.
+        return failWith(kInterrupted, "interrupted; nothing was written");
     } catch (const UsageError& e) {
-        std::cerr << "sweepers-cli: " << e.what() << "\n";
-        return kUsage;
+        return failWith(kUsage, e.what());
     } catch (const std::exception& e) {
-        std::cerr << "sweepers-cli: " << e.what() << "\n";
-        return kFailed;
+        return failWith(kFailed, e.what());
     }
     return kDone;
 }

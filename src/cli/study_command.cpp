@@ -13,6 +13,8 @@
 #include "cli/child_process.h"
 #include "cli/command.h"
 #include "cli/slurm.h"
+#include "core/format.h"
+#include "core/limits.h"
 #include "io/atomic_file.h"
 #include "io/study_files.h"
 #include "io/study_plan.h"
@@ -197,10 +199,16 @@ void runSideBySide(const StudyPlan& plan, const std::vector<std::size_t>& pendin
             const PlannedRun& run = plan.runs[pending[next]];
             const std::string dir = runDirectory(plan, run);
             std::filesystem::create_directories(dir);
-            running.push_back({startProgram({program, "study", "-q", "-o", plan.dir, "--run",
-                                             run.id, "--threads", std::to_string(threads)},
-                                            dir + "/run.log"),
-                               pending[next]});
+            std::vector<std::string> args = {program, "study",     "-q",
+                                             "-o",    plan.dir,    "--run",
+                                             run.id,  "--threads", std::to_string(threads)};
+            // The limits this process was given, the runs too.
+            if (limits().memoryBytes > 0.0)
+                args.insert(args.end(),
+                            {"--max-memory", formatPrecise(limits().memoryBytes / 1e9)});
+            if (limits().work > 0.0)
+                args.insert(args.end(), {"--max-work", formatPrecise(limits().work)});
+            running.push_back({startProgram(args, dir + "/run.log"), pending[next]});
             ++next;
         }
         if (stopping && next < pending.size()) next = pending.size();
@@ -424,7 +432,12 @@ CLI::App* addStudyCommand(CLI::App& app, StudyArgs& a) {
     CLI::Option* list =
         study->add_flag("--list", a.list, "Print the ids of the runs without a result, one a line");
     CLI::Option* run =
-        study->add_option("--run", a.run, "Run one run of the plan in the directory, by id");
+        study->add_option("--run", a.run, "Run one run of the plan in the directory, by id")
+            ->check(CLI::Validator(
+                [](std::string& id) {
+                    return id.empty() ? "needs a run's id (--list prints them)" : std::string();
+                },
+                "ID"));
     CLI::Option* merge = study->add_flag(
         "--merge", a.merge, "Merge the results in the directory into the table, report, plots");
     CLI::Option* slurm =

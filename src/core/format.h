@@ -13,6 +13,13 @@ inline std::string formatNumber(double v) {
     return text;
 }
 
+// All the digits a double needs to read back as itself.
+inline std::string formatPrecise(double v) {
+    char text[64];
+    std::snprintf(text, sizeof text, "%.17g", v);
+    return text;
+}
+
 inline std::string formatBytes(double bytes) {
     char text[64];
     if (bytes >= 1e12)

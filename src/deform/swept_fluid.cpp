@@ -6,6 +6,7 @@
 
 #include <Eigen/Geometry>
 
+#include "core/format.h"
 #include "core/monotone_cubic.h"
 #include "deform/box_solve.h"
 #include "deform/flow.h"
@@ -235,7 +236,14 @@ int sweptFluidSteps(const SweptFluid& fluid, double radius, const Eigen::Vector3
     const double local = (to - from).norm() * fluid.ballRadius / radius; // |W^-1 t|
     if (!(local > 0.0) || !std::isfinite(local))
         throw std::invalid_argument("a fluid tool's move needs a length");
-    return std::max(1, int(std::ceil(local / fluid.centerSpeed))); // 4.26
+    const double steps = std::max(1.0, std::ceil(local / fluid.centerSpeed)); // 4.26
+    // (Compared as a double: a move far longer than the ball counts past any int.)
+    if (!(steps <= kMostFluidSteps))
+        throw std::invalid_argument("a fluid tool moving " + formatNumber((to - from).norm()) +
+                                    " at radius " + formatNumber(radius) + " takes " +
+                                    formatNumber(steps) +
+                                    " flow steps; at most 1e6 (a larger ball, or a shorter path)");
+    return int(steps);
 }
 
 std::unique_ptr<StepDeformation> sweptFluidSegment(const SweptFluid& fluid, double radius,

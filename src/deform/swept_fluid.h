@@ -63,7 +63,9 @@ std::unique_ptr<StepDeformation> sweptFluidSegment(const SweptFluid& fluid, doub
                                                    const Eigen::Vector3d& from,
                                                    const Eigen::Vector3d& to);
 
-// How many steps (4.26) that move takes.
+// The most flow steps one segment of a fluid stroke may take.
+constexpr double kMostFluidSteps = 1e6;
+// How many steps (4.26) that move takes; throws std::invalid_argument past kMostFluidSteps.
 int sweptFluidSteps(const SweptFluid& fluid, double radius, const Eigen::Vector3d& from,
                     const Eigen::Vector3d& to);
 

@@ -15,6 +15,7 @@
 #include <assimp/scene.h>
 
 #include "io/atomic_file.h"
+#include "io/input_file.h"
 
 namespace sweepers {
 
@@ -221,6 +222,7 @@ void validateScene(const aiScene& scene, const std::string& path) {
 } // namespace
 
 TriangleMesh readMesh(const std::string& path) {
+    requireRegularFile(path);
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
     if (extension(path) == "ply") checkPlyCounts(path);
     Assimp::Importer importer;

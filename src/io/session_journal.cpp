@@ -100,6 +100,7 @@ void JournalWriter::checkpointed(const std::string& file, std::size_t strokes) {
 
 JournalState readJournal(const std::string& dir) {
     const std::string path = journalPath(dir);
+    requireRegularFile(path);
     std::ifstream in(path, std::ios::binary);
     if (!in) throw std::runtime_error(path + ": there is no session journal here");
     std::ostringstream all;

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "core/format.h"
+#include "core/limits.h"
 #include "core/memory.h"
 
 #include "io/mesh_file.h"
@@ -18,14 +19,18 @@ void requireMemoryForBand(double area, double voxelSize, double halfWidth, doubl
     // The band is 2 halfWidth voxels thick over the surface.
     const double voxels = area / (voxelSize * voxelSize) * 2.0 * halfWidth;
     const double needed = voxels * bytesPerVoxel;
-    const double available = availableMemoryBytes();
-    if (force || available <= 0.0 || needed <= available) return;
+    const double limit = memoryLimitBytes();
+    if (force || limit <= 0.0 || needed <= limit) return;
     char count[32];
     std::snprintf(count, sizeof count, "%.2g", voxels);
-    throw ScriptError(what + " needs about " + formatBytes(needed) + " of memory (" + count +
-                      " band voxels at voxel size " + formatNumber(voxelSize) +
-                      "), more than the " + formatBytes(available) +
-                      " available; use a coarser voxel size, or --force to try anyway");
+    const std::string whose =
+        limits().memoryBytes > 0.0
+            ? "--max-memory"
+            : "half the " + formatBytes(availableMemoryBytes()) + " available";
+    throw LimitExceeded(what + " needs about " + formatBytes(needed) + " of memory (" + count +
+                        " band voxels at voxel size " + formatNumber(voxelSize) +
+                        "), over its limit of " + formatBytes(limit) + " (" + whose +
+                        "); use a coarser voxel size, --max-memory or --force");
 }
 
 void requireSphereSize(double radius, double voxelSize) {
@@ -43,7 +48,10 @@ void requireBuildableStart(const StrokeScript& script, double voxelSize, bool fo
     const StartShape& s = script.start;
     if (s.kind != StartShape::Kind::Sphere) return;
     requireSphereSize(s.radius, h);
-    requireMemoryForBand(4.0 * M_PI * s.radius * s.radius, h, hw, kSphereBytesPerVoxel, force);
+    // Sculpting needs more than building the start: a script with strokes, as a run does.
+    requireMemoryForBand(4.0 * M_PI * s.radius * s.radius, h, hw,
+                         script.strokes.empty() ? kSphereBytesPerVoxel : kRunBytesPerVoxel, force,
+                         script.strokes.empty() ? "the start shape" : "applying the script");
 }
 
 GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir, double voxelSize,
@@ -64,15 +72,19 @@ GridPtr makeStartGrid(const StrokeScript& script, const std::string& scriptDir, 
         const double fileH = g->voxelSize()[0], fileHw = halfWidthOf(*g);
         auto refuse = [&](const std::string& what, double file, const std::string& asked,
                           double value) {
-            throw ScriptError(resolve(s.file) + ": its " + what + " " + formatNumber(file) +
-                              " differs from " + asked + " " + formatNumber(value) +
-                              " (a VDB start keeps its own grid: give " + formatNumber(file) +
+            // As many digits as tell the two apart.
+            std::string a = formatNumber(file), b = formatNumber(value);
+            if (a == b) a = formatPrecise(file), b = formatPrecise(value);
+            throw ScriptError(resolve(s.file) + ": its " + what + " " + a + " differs from " +
+                              asked + " " + b + " (a VDB start keeps its own grid: give " + a +
                               " or leave the setting out)");
         };
-        if (voxelSize > 0 && std::abs(fileH - voxelSize) > 1e-9 * voxelSize)
+        // A file may hold its voxel size as a float (pyopenvdb writes it so): the same size
+        // to a float's precision is the same.
+        const auto same = [fileH](double h) { return std::abs(fileH - h) <= 4e-7 * h; };
+        if (voxelSize > 0 && !same(voxelSize))
             refuse("voxel size", fileH, "--voxel-size", voxelSize);
-        if (voxelSize <= 0 && script.grid.voxelSizeGiven &&
-            std::abs(fileH - script.grid.voxelSize) > 1e-9 * script.grid.voxelSize)
+        if (voxelSize <= 0 && script.grid.voxelSizeGiven && !same(script.grid.voxelSize))
             refuse("voxel size", fileH, "the script's /grid/voxel_size", script.grid.voxelSize);
         if (script.grid.halfWidthGiven && std::abs(fileHw - script.grid.halfWidth) > 1e-3)
             refuse("band half-width", fileHw, "the script's /grid/half_width",

@@ -31,10 +31,14 @@ void requireSphereSize(double radius, double voxelSize);
 // Peak memory per band voxel while a start is built (measured: a sphere about 28 bytes, a
 // mesh conversion 40 to 65), with some headroom.
 constexpr double kSphereBytesPerVoxel = 32.0, kMeshBytesPerVoxel = 64.0;
+// Peak resident memory per band voxel of a run's grid while it is sculpted, measured and
+// meshed (the grid, the advector's scratch, undo's or the reference's copies, the mesh),
+// with headroom: what `apply` and a study's run need.
+constexpr double kRunBytesPerVoxel = 160.0;
 
-// Throws ScriptError when a band of `halfWidth` voxels around a surface of `area` would
-// need more memory than is available (unless `force`), with both figures in the message,
-// which begins with `what`.
+// Throws LimitExceeded when a band of `halfWidth` voxels around a surface of `area` would
+// need more memory than the limit (core/limits.h; unless `force`), with both figures in the
+// message, which begins with `what`.
 void requireMemoryForBand(double area, double voxelSize, double halfWidth, double bytesPerVoxel,
                           bool force, const std::string& what = "the start shape");
 

@@ -19,6 +19,7 @@
 #include "io/atomic_file.h"
 #include "io/baked_tool.h"
 #include "io/fluid_cache.h"
+#include "io/input_file.h"
 #include "io/velocity_file.h"
 
 namespace sweepers {
@@ -96,16 +97,26 @@ class Reader {
         return *it;
     }
 
+    // Every number of a script (a length, a time, an angle, a strength) lies within
+    // kLargestNumber of zero, and every positive one at least kSmallestPositive from it: far
+    // beyond a shape's scale, but within what converts to a voxel index or a step count
+    // without overflow (a size of 1e30 once made strokes that silently did nothing).
+    static constexpr double kLargestNumber = 1e5, kSmallestPositive = 1e-9;
+
     double number(const json& v, const std::string& where) const {
         if (!v.is_number()) fail(where, "expected a number, got " + describe(v));
         const double d = v.get<double>();
         if (!std::isfinite(d)) fail(where, "the number is not finite");
+        if (std::abs(d) > kLargestNumber)
+            fail(where, v.dump() + " is beyond the largest number a script takes, 1e5");
         return d;
     }
 
     double positive(const json& v, const std::string& where) const {
         const double d = number(v, where);
         if (!(d > 0.0)) fail(where, "must be positive (got " + v.dump() + ")");
+        if (d < kSmallestPositive)
+            fail(where, v.dump() + " is below the smallest positive number a script takes, 1e-9");
         return d;
     }
 
@@ -753,13 +764,14 @@ StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
 }
 
 StrokeScript readStrokeScript(const std::string& path, std::string* text) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw ScriptError(path + ": cannot open the file");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    if (in.bad()) throw ScriptError(path + ": cannot read the file");
-    if (text) *text = ss.str();
-    return parseStrokeScript(ss.str(), path, directoryOf(path));
+    std::string all;
+    try {
+        all = readWholeFile(path, kMostTextBytes, "a stroke script");
+    } catch (const FileError& e) {
+        throw ScriptError(e.what());
+    }
+    if (text) *text = all;
+    return parseStrokeScript(all, path, directoryOf(path));
 }
 
 namespace {

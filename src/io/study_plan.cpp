@@ -30,10 +30,6 @@ using nlohmann::json;
 constexpr const char* kPlanFormat = "sweepers study plan 1";
 constexpr const char* kResultFormat = "sweepers study result 1";
 
-// Peak resident memory per active voxel of a run's grid while it is sculpted, measured, and
-// meshed (the grid, the advector's scratch, the mesh and the reference's copy of the start),
-// with headroom: what a finer run needs beyond the coarsest one's peak.
-constexpr double kRunBytesPerVoxel = 128.0;
 // What a run holds before it has a grid: the program, its libraries and thread stacks.
 constexpr double kRunBaseMb = 64.0;
 
@@ -70,6 +66,7 @@ class Digest {
         return *this;
     }
     Digest& addFile(const std::string& path) {
+        requireRegularFile(path);
         std::ifstream in(path, std::ios::binary);
         if (!in) throw FileError(path + ": cannot read it");
         std::vector<char> buffer(1 << 20);
@@ -125,6 +122,7 @@ StudyRow plannedRow(const StudyPlan& plan, const PlannedRun& run) {
 }
 
 json readJsonFile(const std::string& path) {
+    requireRegularFile(path, kMostTextBytes, "a study's file");
     std::ifstream in(path);
     if (!in) throw FileError(path + ": cannot read it");
     try {

@@ -29,6 +29,20 @@ std::size_t nonFiniteValues(const Grid& grid) {
 std::string unusable(const Grid& grid) {
     if (!grid.hasUniformVoxels() || !grid.transform().isLinear())
         return "has non-uniform voxels; Sweepers needs cubic voxels";
+    // A mirroring map (a negative scale) turns the level set's inside out in world space:
+    // every stroke would move the wrong side.
+    if (!(grid.transform().baseMap()->determinant() > 0.0))
+        return "has a mirrored transform (a negative scale); Sweepers needs one that keeps "
+               "left and right";
+    // Far out, a float's voxel positions and a script's numbers (at most 1e5) no longer
+    // reach it: refused as a script's shape would be.
+    const openvdb::CoordBBox box = grid.evalActiveVoxelBoundingBox();
+    if (!box.empty()) {
+        const openvdb::Vec3d lo = grid.indexToWorld(box.min()), hi = grid.indexToWorld(box.max());
+        for (int a = 0; a < 3; ++a)
+            if (!(std::max(std::abs(lo[a]), std::abs(hi[a])) <= 1e5))
+                return "lies beyond 1e5 of the origin, farther than Sweepers sculpts";
+    }
     const double hw = halfWidthOf(grid);
     if (!(hw >= kMinHalfWidth - 1e-6))
         return "has a band of " + formatNumber(hw) + " voxels; Sweepers needs at least 2";
@@ -40,6 +54,7 @@ std::string unusable(const Grid& grid) {
 } // namespace
 
 LevelSetFile readLevelSetFile(const std::string& path, const std::string& gridName) {
+    requireRegularFile(path);
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
     return readLevelSetInChild(path, gridName);
 }
@@ -87,6 +102,7 @@ LevelSetFile readLevelSetInProcess(const std::string& path, const std::string& g
 
 openvdb::GridPtrVecPtr readAllGrids(const std::string& path) {
     initVdb();
+    requireRegularFile(path);
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
     try {
         openvdb::io::File file(path);

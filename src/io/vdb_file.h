@@ -11,14 +11,10 @@
 #include <vector>
 
 #include "io/atomic_file.h"
+#include "io/input_file.h"
 #include "levelset/vdb.h"
 
 namespace sweepers {
-
-class FileError : public std::runtime_error {
-  public:
-    using std::runtime_error::runtime_error;
-};
 
 // A level set read from a file, and what else the file holds.
 struct LevelSetFile {

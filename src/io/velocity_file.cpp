@@ -4,6 +4,7 @@
 #include <fstream>
 
 #include "core/format.h"
+#include "io/input_file.h"
 #include "io/isolated_read.h"
 
 namespace sweepers {
@@ -65,6 +66,7 @@ VelocityFile readVelocityInProcess(const std::string& path, const std::string& g
 }
 
 VelocitySamples readVelocitySamples(const std::string& path, const std::string& gridName) {
+    requireRegularFile(path);
     if (!std::ifstream(path).good()) throw FileError(path + ": cannot open the file");
     return velocitySamples(readVelocityInChild(path, gridName), path);
 }

@@ -7,6 +7,8 @@
 #include <tbb/enumerable_thread_specific.h>
 
 #include "core/falloff.h"
+#include "core/format.h"
+#include "core/limits.h"
 #include "levelset/dilate.h"
 #include "levelset/fast_marching.h"
 #include "levelset/parallel.h"
@@ -110,6 +112,7 @@ SmoothStats CurvatureSmoother::run() {
     if (!(brush_.time > 0.0) || !(brush_.radius > 0.0)) return stats_;
     collectLeaves();
     weigh();
+    requireAffordable();
     widenBand();
     pollInterrupt(interrupter_);
     flow();
@@ -199,13 +202,30 @@ void CurvatureSmoother::widenBand() {
     }
 }
 
-void CurvatureSmoother::flow() {
+double CurvatureSmoother::stepCount() const {
     const double h = grid_.voxelSize()[0];
     // Explicit steps of the central scheme are stable for dt <= h^2 / 4: along the surface
     // (|grad phi| = 1) the flow is a diffusion in two dimensions, whose fastest mode (the
     // checkerboard) decays at 8 / h^2. A little under it.
     const double dtMax = 0.9 * h * h / 4.0;
-    const int steps = std::max(1, int(std::ceil(brush_.time / dtMax)));
+    return std::max(1.0, std::ceil(brush_.time / dtMax));
+}
+
+// Before the grid changes: the flow's steps times the voxels that flow, against the work
+// limit (a ball far larger than the shape, or far finer a grid, would flow for hours).
+void CurvatureSmoother::requireAffordable() const {
+    double voxels = 0.0;
+    for (const LeafVoxels& lv : weighted_)
+        for (const leafwords::Word w : lv.words)
+            voxels += double(__builtin_popcountll(w));
+    requireWork(stepCount() * voxels, "a smooth dab of radius " + formatNumber(brush_.radius) +
+                                          " (" + formatNumber(stepCount()) + " steps of " +
+                                          formatNumber(voxels) + " voxels)");
+}
+
+void CurvatureSmoother::flow() {
+    const double h = grid_.voxelSize()[0];
+    const int steps = int(stepCount()); // (within the work limit: far below INT_MAX)
     const double dt = brush_.time / steps;
     stats_.steps = steps;
     // The whole band flows, so that the differences read consistent values; no value moves

@@ -61,10 +61,12 @@ class CurvatureSmoother {
     // The ball renormalization recomputes: the reach less the voxel the band may take in
     // next to it (in voxels, about the brush's centre).
     double renormalizedRadius() const;
-    void collectLeaves(); // the leaves of the band inside the reach
-    void weigh();         // the brush's weight at each band voxel, and the leaves that flow
-    void widenBand();     // two more voxels of band around the voxels that flow
-    void flow();          // the explicit steps of the flow
+    double stepCount() const; // explicit steps of the flow, at least 1
+    void collectLeaves();     // the leaves of the band inside the reach
+    void weigh();             // the brush's weight at each band voxel, and the leaves that flow
+    void requireAffordable() const; // throws LimitExceeded beyond the work limit
+    void widenBand();               // two more voxels of band around the voxels that flow
+    void flow();                    // the explicit steps of the flow
     void renormalizeReach();
 
     using Leaf = Grid::TreeType::LeafNodeType;

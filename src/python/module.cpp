@@ -13,6 +13,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "core/limits.h"
 #include "io/isolated_read.h"
 #include "io/mesh_file.h"
 #include "io/start_grid.h"
@@ -45,14 +46,15 @@ class InterruptScope {
     InterruptScope() {
         const py::module_ threading = py::module_::import("threading");
         if (!threading.attr("current_thread")().is(threading.attr("main_thread")())) return;
-        gInterrupted.store(&flag);
         struct sigaction action = {};
         action.sa_handler = onInterrupt;
         sigemptyset(&action.sa_mask);
         installed_ = ::sigaction(SIGINT, &action, &previous_) == 0;
+        if (installed_) gInterrupted.store(&flag);
     }
     ~InterruptScope() {
-        if (installed_) ::sigaction(SIGINT, &previous_, nullptr);
+        if (!installed_) return; // (another thread's: the main thread's work keeps its own)
+        ::sigaction(SIGINT, &previous_, nullptr);
         gInterrupted.store(nullptr);
     }
     InterruptScope(const InterruptScope&) = delete;
@@ -139,18 +141,63 @@ auto runEngine(const py::object& progress, const std::string& what, const Work& 
     ProgressCall call(progress, what, &scope.flag);
     const Progress report = call.progress();
     try {
-        py::gil_scoped_release release;
-        return work(&scope.flag, report);
+        auto result = [&] {
+            py::gil_scoped_release release;
+            return work(&scope.flag, report);
+        }();
+        // The callback raised on its last call, after the engine's last poll: the call fails
+        // all the same (what it made is dropped).
+        call.raiseCallbackError();
+        return result;
     } catch (const Cancelled&) {
         call.raiseCallbackError();
         throw;
     }
 }
 
+// Runs `read(session)` without the GIL once no other thread is using the session. A caller
+// waits for the session without the GIL: the one using it may need the GIL for its progress
+// callback.
+template <typename Read> auto withSession(const Session& session, const Read& read) {
+    py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> lock(session.busy());
+    return read(session);
+}
+
 // --- values ------------------------------------------------------------------------------
 
-std::string textOf(const py::handle& value) {
-    return py::module_::import("json").attr("dumps")(value).cast<std::string>();
+// A value as JSON text; ValueError for a number JSON cannot hold (NaN, infinity), which
+// json.dumps would write as a word no JSON reader takes.
+std::string textOf(const py::handle& value, const std::string& what) {
+    try {
+        return py::module_::import("json")
+            .attr("dumps")(value, py::arg("allow_nan") = false)
+            .cast<std::string>();
+    } catch (py::error_already_set& e) {
+        if (!e.matches(PyExc_ValueError)) throw;
+        throw py::value_error(what + " holds a number that is not finite (NaN or infinity)");
+    }
+}
+
+// The name of a value's type, for messages.
+std::string typeName(const py::handle& value) {
+    return py::str(py::type::of(value).attr("__name__")).cast<std::string>();
+}
+
+// A number given to a parameter: TypeError naming the parameter for anything else (a bool
+// is not a number here).
+double numberFrom(const py::handle& value, const std::string& what) {
+    if (py::isinstance<py::bool_>(value) ||
+        !(py::isinstance<py::float_>(value) || py::isinstance<py::int_>(value)))
+        throw py::type_error(what + ": a number, not " + typeName(value));
+    return value.cast<double>();
+}
+
+// A string given to a parameter: TypeError naming the parameter for anything else.
+std::string stringFrom(const py::handle& value, const std::string& what) {
+    if (!py::isinstance<py::str>(value))
+        throw py::type_error(what + ": a string, not " + typeName(value));
+    return value.cast<std::string>();
 }
 
 py::object fromJson(const std::string& text) {
@@ -174,7 +221,9 @@ struct GivenScript {
 GivenScript scriptFrom(const py::handle& value) {
     const std::string here = std::filesystem::current_path().string();
     if (py::isinstance<py::dict>(value))
-        return {parseStrokeScript(textOf(value), "the script (a dict)", here), here};
+        return {
+            parseStrokeScript(textOf(value, "the script (a dict)"), "the script (a dict)", here),
+            here};
     if (!py::isinstance<py::str>(value) && !isPath(value))
         throw py::type_error("script: a path, a JSON string or a dict, not " +
                              py::str(py::type::of(value)).cast<std::string>());
@@ -194,7 +243,7 @@ GivenScript scriptFrom(const py::handle& value) {
 
 double voxelSizeFrom(const py::object& value) {
     if (value.is_none()) return 0.0;
-    const double h = value.cast<double>();
+    const double h = numberFrom(value, "voxel_size");
     if (!(h > 0.0 && std::isfinite(h)))
         throw std::invalid_argument("voxel_size must be a positive number, not " +
                                     py::repr(value).cast<std::string>());
@@ -203,22 +252,17 @@ double voxelSizeFrom(const py::object& value) {
 
 using Points = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-// A shape's values at an n x 3 array of points (`at` is Shape::sample or exactDistance),
-// computed without the GIL.
-py::array_t<double> valuesAt(const Shape& shape, const Points& points,
-                             std::vector<double> (Shape::*at)(const std::vector<Eigen::Vector3d>&)
-                                 const) {
+std::vector<Eigen::Vector3d> pointsOf(const Points& points) {
     if (points.ndim() != 2 || points.shape(1) != 3)
         throw std::invalid_argument("points: an n x 3 array");
     std::vector<Eigen::Vector3d> p(std::size_t(points.shape(0)));
     const auto in = points.unchecked<2>();
     for (py::ssize_t i = 0; i < points.shape(0); ++i)
         p[std::size_t(i)] = {in(i, 0), in(i, 1), in(i, 2)};
-    std::vector<double> values;
-    {
-        py::gil_scoped_release release;
-        values = (shape.*at)(p);
-    }
+    return p;
+}
+
+py::array_t<double> arrayOf(const std::vector<double>& values) {
     py::array_t<double> out(py::ssize_t(values.size()));
     std::copy(values.begin(), values.end(), out.mutable_data());
     return out;
@@ -260,47 +304,55 @@ py::object toPyopenvdb(const std::string& bytes) {
     return grid;
 }
 
-// The methods a Shape and a Sculptor share, on the shape `of(self)` gives.
-template <typename Class, typename Of> void addShapeMethods(Class& cls, const Of& of) {
+// The methods a Shape and a Sculptor share. `with(self, read)` gives read(the shape now),
+// computed without the GIL (and, for a Sculptor, while no other thread sculpts it).
+template <typename Class, typename With> void addShapeMethods(Class& cls, const With& with) {
+    using Self = typename Class::type;
     cls.def_property_readonly(
-           "volume", [of](const typename Class::type& s) { return of(s).measures().volume; },
+           "volume",
+           [with](const Self& s) {
+               return with(s, [](const Shape& x) { return x.measures().volume; });
+           },
            "The enclosed volume (world units cubed).")
         .def_property_readonly(
-            "area", [of](const typename Class::type& s) { return of(s).measures().area; },
+            "area",
+            [with](const Self& s) {
+                return with(s, [](const Shape& x) { return x.measures().area; });
+            },
             "The surface area (world units squared).")
         .def_property_readonly(
             "voxel_size",
-            [of](const typename Class::type& s) { return of(s).grid().voxelSize()[0]; },
+            [with](const Self& s) {
+                return with(s, [](const Shape& x) { return x.grid().voxelSize()[0]; });
+            },
             "The grid's voxel size.")
         .def_property_readonly(
             "topology",
-            [of](const typename Class::type& s) { return topologyOf(of(s).measures()); },
+            [with](const Self& s) {
+                return topologyOf(with(s, [](const Shape& x) { return x.measures(); }));
+            },
             "{'euler_characteristic', 'genus', 'components'} of the surface.")
         .def(
             "mesh",
-            [of](const typename Class::type& s) {
-                const Shape& shape = of(s);
-                TriangleMesh mesh;
-                {
-                    py::gil_scoped_release release;
-                    mesh = shape.mesh();
-                }
-                return meshArrays(mesh);
+            [with](const Self& s) {
+                return meshArrays(with(s, [](const Shape& x) { return x.mesh(); }));
             },
             "The surface as (vertices float32 n x 3, triangles int32 m x 3): the welded mesh "
             "that `sweepers-cli apply --mesh` exports.")
         .def(
             "sample",
-            [of](const typename Class::type& s, const Points& points) {
-                return valuesAt(of(s), points, &Shape::sample);
+            [with](const Self& s, const Points& points) {
+                const std::vector<Eigen::Vector3d> p = pointsOf(points);
+                return arrayOf(with(s, [&](const Shape& x) { return x.sample(p); }));
             },
             py::arg("points"),
             "The grid's signed distance (trilinear, negative inside) at an n x 3 array of "
             "points.")
         .def(
             "exact_distance",
-            [of](const typename Class::type& s, const Points& points) {
-                return valuesAt(of(s), points, &Shape::exactDistance);
+            [with](const Self& s, const Points& points) {
+                const std::vector<Eigen::Vector3d> p = pointsOf(points);
+                return arrayOf(with(s, [&](const Shape& x) { return x.exactDistance(p); }));
             },
             py::arg("points"),
             "The exact shape's implicit function at an n x 3 array of points: the start "
@@ -309,20 +361,25 @@ template <typename Class, typename Of> void addShapeMethods(Class& cls, const Of
             "negative inside).")
         .def(
             "to_vdb_bytes",
-            [of](const typename Class::type& s) { return py::bytes(of(s).vdbBytes()); },
+            [with](const Self& s) {
+                return py::bytes(with(s, [](const Shape& x) { return x.vdbBytes(); }));
+            },
             "The level set as a VDB stream in memory (openvdb::io::Stream), as `apply` "
             "writes it.")
         .def(
             "to_pyopenvdb",
-            [of](const typename Class::type& s) { return toPyopenvdb(of(s).vdbBytes()); },
+            [with](const Self& s) {
+                return toPyopenvdb(with(s, [](const Shape& x) { return x.vdbBytes(); }));
+            },
             "The level set as a pyopenvdb.FloatGrid (needs pyopenvdb).")
         .def(
             "save",
-            [of](const typename Class::type& s, const py::object& path) {
+            [with](const Self& s, const py::object& path) {
                 const std::string p = pathOf(path);
-                const Shape& shape = of(s);
-                py::gil_scoped_release release;
-                shape.save(p);
+                with(s, [&](const Shape& x) {
+                    x.save(p);
+                    return 0;
+                });
             },
             py::arg("path"),
             "Writes the level set (.vdb) or its surface (.obj, .ply, .stl), atomically.");
@@ -360,7 +417,7 @@ std::vector<Stroke> strokesFrom(const py::object& strokes) {
     py::dict script;
     script["sweepers"] = 1;
     script["strokes"] = list;
-    return parseStrokeScript(textOf(script), "the strokes",
+    return parseStrokeScript(textOf(script, "the strokes"), "the strokes",
                              std::filesystem::current_path().string())
         .strokes;
 }
@@ -400,10 +457,11 @@ py::object study(const py::object& scripts, const py::object& voxelSizes,
     std::vector<StudyVariant> kinds;
     for (const py::handle v : py::isinstance<py::str>(variants) ? py::list(py::make_tuple(variants))
                                                                 : py::list(variants)) {
-        const auto kind = parseVariant(v.cast<std::string>());
+        const std::string name = stringFrom(v, "variants");
+        const auto kind = parseVariant(name);
         if (!kind)
-            throw std::invalid_argument("variants: unknown variant '" + v.cast<std::string>() +
-                                        "' (" + variantNames() + ")");
+            throw std::invalid_argument("variants: unknown variant '" + name + "' (" +
+                                        variantNames() + ")");
         kinds.push_back(*kind);
     }
     if (paths.empty() || sizes.empty() || kinds.empty())
@@ -479,10 +537,46 @@ PYBIND11_MODULE(sweepers, m) {
         }
     });
 
+    // A refusal by the limits: the estimate, the limit and how to raise it.
+    py::register_exception<LimitExceeded>(m, "LimitError", PyExc_RuntimeError);
+    m.def(
+        "set_limits",
+        [](const py::object& maxMemory, const py::object& maxWork) {
+            Limits l;
+            const auto positive = [](const py::object& v, const std::string& what) {
+                if (v.is_none()) return 0.0;
+                const double x = numberFrom(v, what);
+                if (!(x > 0.0 && std::isfinite(x)))
+                    throw py::value_error(what + " must be a positive number or None");
+                return x;
+            };
+            l.memoryBytes = positive(maxMemory, "max_memory");
+            l.work = positive(maxWork, "max_work");
+            setLimits(l);
+        },
+        py::arg("max_memory") = py::none(), py::arg("max_work") = py::none(),
+        "Refuse work whose estimate exceeds `max_memory` bytes (None: half the memory "
+        "available) or a stroke whose estimate exceeds `max_work` voxel updates (None: 2e9), "
+        "with sweepers.LimitError, before it starts: as sweepers-cli's --max-memory and "
+        "--max-work.");
+    m.def(
+        "limits",
+        [] {
+            py::dict d;
+            d["max_memory"] = memoryLimitBytes();
+            d["max_work"] = workLimit();
+            return d;
+        },
+        "The limits in force: {'max_memory': bytes, 'max_work': voxel updates}.");
+
     py::class_<Shape> shape(m, "Shape",
                             "A sculpted level set with the history that made it "
                             "(sweepers.apply, Sculptor.shape()).");
-    addShapeMethods(shape, [](const Shape& s) -> const Shape& { return s; });
+    addShapeMethods(shape, [](const Shape& s, const auto& read) {
+        // A Shape never changes: any number of threads may read it at once.
+        py::gil_scoped_release release;
+        return read(s);
+    });
 
     m.def(
         "apply",
@@ -510,12 +604,13 @@ PYBIND11_MODULE(sweepers, m) {
                  py::dict grid;
                  const double h = voxelSizeFrom(voxelSize);
                  if (h > 0.0) grid["voxel_size"] = h;
-                 if (!halfWidth.is_none()) grid["half_width"] = halfWidth.cast<double>();
+                 if (!halfWidth.is_none()) grid["half_width"] = numberFrom(halfWidth, "half_width");
                  script["grid"] = grid;
                  script["start"] = startFrom(start);
                  script["strokes"] = py::list();
                  const std::string here = std::filesystem::current_path().string();
-                 const StrokeScript parsed = parseStrokeScript(textOf(script), "the start", here);
+                 const StrokeScript parsed =
+                     parseStrokeScript(textOf(script, "the start"), "the start", here);
                  return runEngine(py::none(), "start", [&](Interrupter* stop, const Progress&) {
                      return std::make_unique<Session>(parsed, here, stop);
                  });
@@ -531,6 +626,7 @@ PYBIND11_MODULE(sweepers, m) {
             [](Session& s, const py::object& strokes, const py::object& progress) {
                 const std::vector<Stroke> parsed = strokesFrom(strokes);
                 runEngine(progress, "sculpting", [&](Interrupter* stop, const Progress& report) {
+                    const std::lock_guard<std::mutex> lock(s.busy());
                     s.apply(parsed, stop, report);
                     return 0;
                 });
@@ -541,27 +637,48 @@ PYBIND11_MODULE(sweepers, m) {
         .def(
             "undo",
             [](Session& s) {
-                return runEngine(py::none(), "undo",
-                                 [&](Interrupter*, const Progress&) { return s.undo(); });
+                return runEngine(py::none(), "undo", [&](Interrupter*, const Progress&) {
+                    const std::lock_guard<std::mutex> lock(s.busy());
+                    return s.undo();
+                });
             },
             "Takes back the last apply(); False when there is none.")
         .def(
             "redo",
             [](Session& s) {
-                return runEngine(py::none(), "redo",
-                                 [&](Interrupter*, const Progress&) { return s.redo(); });
+                return runEngine(py::none(), "redo", [&](Interrupter*, const Progress&) {
+                    const std::lock_guard<std::mutex> lock(s.busy());
+                    return s.redo();
+                });
             },
             "Applies again what undo() took back; False when there is none.")
-        .def_property_readonly("can_undo", &Session::canUndo)
-        .def_property_readonly("can_redo", &Session::canRedo)
+        .def_property_readonly("can_undo",
+                               [](const Session& s) {
+                                   return withSession(s,
+                                                      [](const Session& x) { return x.canUndo(); });
+                               })
+        .def_property_readonly("can_redo",
+                               [](const Session& s) {
+                                   return withSession(s,
+                                                      [](const Session& x) { return x.canRedo(); });
+                               })
         .def(
-            "script", [](const Session& s) { return fromJson(formatStrokeScript(s.script())); },
+            "script",
+            [](const Session& s) {
+                return fromJson(withSession(
+                    s, [](const Session& x) { return formatStrokeScript(x.script()); }));
+            },
             "The session as a stroke script (a dict): its start and every stroke applied. "
             "`sweepers-cli apply` replays it to the same grid, voxel for voxel.")
         .def(
-            "shape", [](const Session& s) { return s.shape(); },
+            "shape",
+            [](const Session& s) {
+                return withSession(s, [](const Session& x) { return x.shape(); });
+            },
             "The shape now, as a Shape that later strokes do not change.");
-    addShapeMethods(sculptor, [](const Session& s) { return s.view(); });
+    addShapeMethods(sculptor, [](const Session& s, const auto& read) {
+        return withSession(s, [&](const Session& x) { return read(x.view()); });
+    });
 
     // The variants' names from the list the parser reads; kept for the module's lifetime.
     static const std::string studyDoc =

@@ -122,6 +122,9 @@ void Session::apply(const std::vector<Stroke>& strokes, Interrupter* interrupter
             document_.applyStroke(stroke, [&](const SegmentReport& r) {
                 applied.back().push_back(r.deformation);
                 if (progress) progress(++done, total);
+                // A stop asked for by the report (Python's callback raised) takes the call back
+                // even after the last segment, when the engine polls no more.
+                pollInterrupt(interrupter);
             });
         }
         document_.endEdit();

@@ -3,6 +3,7 @@
 // a window). Errors are the engine's own exceptions; the bindings turn them into Python's.
 #pragma once
 
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -64,8 +65,12 @@ class Session {
     // The shape now, its grid the session's own: valid until the session changes.
     Shape view() const;
     const Grid& grid() const { return document_.grid(); }
+    // Held by whoever calls the session (the Python module, around every call): one caller
+    // at a time, since sculpting rewrites the grid that readers walk.
+    std::mutex& busy() const { return busy_; }
 
   private:
+    mutable std::mutex busy_;
     std::string baseDir_;
     Document document_;
     ExactReference::StartFunction start_;

@@ -66,3 +66,9 @@ def study(scripts: Union[PathLike, Sequence[PathLike]],
           variants: Union[str, Sequence[str]] = ("corrected",),
           directory: Optional[PathLike] = None, force: bool = False,
           progress: Progress = None) -> Union["pandas.DataFrame", List[Dict[str, Any]]]: ...
+
+class LimitError(RuntimeError):
+    """Work refused before it started: its estimate exceeds a limit (set_limits)."""
+
+def set_limits(max_memory: Optional[float] = None, max_work: Optional[float] = None) -> None: ...
+def limits() -> Dict[str, float]: ...

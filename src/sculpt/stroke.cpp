@@ -5,6 +5,8 @@
 
 #include <openvdb/tools/Interpolation.h>
 
+#include "core/format.h"
+#include "core/limits.h"
 #include "deform/inflate.h"
 #include "levelset/band.h"
 #include "tools/ellipsoid.h"
@@ -237,8 +239,18 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
             [&](const FluidStroke& s) {
                 if (!s.fluid) throw std::invalid_argument("the swept fluid was not solved");
                 const std::vector<Eigen::Vector3d> path = s.ballPath();
-                for (std::size_t k = 0; k + 1 < path.size(); ++k)
+                // Each flow step resamples the band its segment reaches: at most the whole
+                // band, at most the voxels of the segment's box.
+                const double h = grid.voxelSize()[0], band = double(grid.activeVoxelCount());
+                for (std::size_t k = 0; k + 1 < path.size(); ++k) {
                     parts.push_back(sweptFluidSegment(*s.fluid, s.radius, path[k], path[k + 1]));
+                    const Box box = parts.back()->affectedBox();
+                    const Eigen::Vector3d extent = (box.max - box.min) / h;
+                    requireWork(sweptFluidSteps(*s.fluid, s.radius, path[k], path[k + 1]) *
+                                    std::min(band, extent.prod()),
+                                "fluid segment " + std::to_string(k + 1) + " of radius " +
+                                    formatNumber(s.radius));
+                }
             },
             [&](const SmoothStroke&) {},
         },

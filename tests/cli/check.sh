@@ -22,4 +22,17 @@ grep -q "bad.json: /strokes/0/tools/0/falloff: must be positive" "$tmp/err" || {
 
 if "$cli" check "$tmp/missing.json" 2>"$tmp/err"; then echo "a missing file was accepted"; exit 1; fi
 grep -q "missing.json: cannot open" "$tmp/err"
+
+# Every stroke kind apply takes, check takes (a smooth stroke once failed with
+# "std::get: wrong index for variant"): every data script, and a smooth stroke.
+for script in "$data"/*.json "$data"/animation/*.json "$data"/flows/*.json "$data"/studies/*.json; do
+  "$cli" check "$script" >"$tmp/out" 2>"$tmp/err" || { echo "$script:"; cat "$tmp/err"; exit 1; }
+done
+printf '{"sweepers": 1, "strokes": [{"type": "smooth", "tool": {"shape": "ball", "size": 0.3, "falloff": 0.2, "path": [{"t": [0, 1, 0]}, {"t": [0, 0.9, 0.3]}]}, "radial": {"count": 3, "axis": [0, 1, 0], "center": [0, 0, 0]}}]}' >"$tmp/smooth.json"
+"$cli" check "$tmp/smooth.json" >"$tmp/out" 2>"$tmp/err" || { cat "$tmp/err"; exit 1; }
+grep -q "stroke 0: smooth, 6 dab(s)" "$tmp/out" || { cat "$tmp/out"; exit 1; }
+"$cli" check --json "$tmp/smooth.json" | /usr/bin/python3 -c '
+import json, sys
+plan = json.load(sys.stdin)["deformations"]
+assert plan == [{"stroke": 0, "type": "smooth", "dabs": 6}], plan'
 echo "check: ok"

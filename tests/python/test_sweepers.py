@@ -478,3 +478,124 @@ def test_the_engine_releases_the_gil():
         ticks.append(1)  # runs only while the apply does not hold the GIL
     t.join()
     assert len(ticks) > 1000
+
+
+def test_threads_sharing_a_sculptor_take_turns():
+    # Two or more threads sculpting one Sculptor crashed or hung (the engine runs without the
+    # GIL): each call now waits for the one using it. Four threads apply strokes, two read
+    # it meanwhile, and two more sculpt Sculptors of their own.
+    shared = sweepers.Sculptor(voxel_size=1 / 32)
+    own = [sweepers.Sculptor(voxel_size=1 / 32) for _ in range(2)]
+    errors, sculpting = [], threading.Event()
+
+    def guarded(work):
+        def run():
+            try:
+                work()
+            except BaseException as e:  # noqa: B036 (any failure fails the test)
+                errors.append(e)
+        return run
+
+    def sculpt(first):
+        for k in range(4):
+            shared.apply(STROKES[(first + k) % len(STROKES)])
+            sculpting.set()
+
+    def read():
+        sculpting.wait()
+        for _ in range(20):
+            shared.sample(np.zeros((8, 3)))
+            assert shared.topology["components"] >= 1 and shared.volume > 0
+            shared.can_undo, shared.script()
+
+    def alone(s):
+        for stroke in STROKES[:3]:
+            s.apply(stroke)
+
+    threads = ([threading.Thread(target=guarded(lambda f=f: sculpt(f))) for f in (0, 2, 5, 7)]
+               + [threading.Thread(target=guarded(read)) for _ in range(2)]
+               + [threading.Thread(target=guarded(lambda s=s: alone(s))) for s in own])
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=600)
+    assert not any(t.is_alive() for t in threads) and errors == []
+    # Sixteen whole strokes, one after another: the session's script replays to its grid.
+    script = shared.script()
+    assert len(script["strokes"]) == 16
+    assert voxels(sweepers.apply(script).to_pyopenvdb()) == voxels(shared.to_pyopenvdb())
+    for s in own:
+        assert voxels(s.to_pyopenvdb()) == voxels(sweepers.apply(s.script()).to_pyopenvdb())
+    # Undo takes back the strokes one call at a time, from any thread.
+    undo = [threading.Thread(target=shared.undo) for _ in range(16)]
+    for t in undo:
+        t.start()
+    for t in undo:
+        t.join()
+    assert shared.script()["strokes"] == [] and not shared.can_undo
+
+
+def test_an_error_in_the_progress_callbacks_last_call_is_raised():
+    calls = []
+
+    def fail_at_the_end(done, total):
+        calls.append(done)
+        if done == total:
+            raise RuntimeError("the last report")
+
+    s = sweepers.Sculptor(voxel_size=1 / 32)
+    with pytest.raises(RuntimeError, match="the last report"):
+        s.apply(STROKES[0], progress=fail_at_the_end)
+    assert calls and s.script()["strokes"] == [] and not s.can_undo
+    with pytest.raises(RuntimeError, match="the last report"):
+        sweepers.apply(RIGID, voxel_size=1 / 16, progress=fail_at_the_end)
+
+
+def test_wrong_types_raise_type_error_and_nan_in_a_dict_says_so(tmp_path):
+    for call in (lambda: sweepers.apply(RIGID, voxel_size="fine"),
+                 lambda: sweepers.Sculptor(voxel_size=[0.1]),
+                 lambda: sweepers.Sculptor(half_width="3"),
+                 lambda: sweepers.apply(RIGID, voxel_size=True),
+                 lambda: sweepers.study(RIGID, ["1/8"], variants=[3], directory=tmp_path)):
+        with pytest.raises(TypeError):
+            call()
+    script = json.load(open(RIGID))
+    script["strokes"][0]["tools"][0]["size"] = float("nan")
+    with pytest.raises(ValueError, match="not finite"):
+        sweepers.apply(script)
+
+
+def test_a_vdb_with_a_float_voxel_size_is_that_voxel_size(tmp_path):
+    # pyopenvdb keeps a voxel size of 0.1 as the float nearest it.
+    g = vdb.createLevelSetSphere(radius=0.5, voxelSize=0.1)
+    g.name = "surface"
+    path = str(tmp_path / "float.vdb")
+    vdb.write(path, grids=[g])
+    s = sweepers.Sculptor(start=path, voxel_size=0.1)
+    assert abs(s.voxel_size - 0.1) < 1e-8
+    with pytest.raises(ValueError, match="0.100000001"):
+        sweepers.Sculptor(start=path, voxel_size=0.1000001)
+
+
+def test_work_past_the_limits_is_refused_and_changes_nothing():
+    smooth = {"type": "smooth", "tool": {"shape": "ball", "size": 0.3, "falloff": 0.1,
+                                         "path": [{"t": [0, 1, 0]}]}}
+    s = sweepers.Sculptor(voxel_size=1 / 32)
+    before = voxels(s.to_pyopenvdb())
+    assert sweepers.limits()["max_work"] == 2e9 and sweepers.limits()["max_memory"] > 0
+    sweepers.set_limits(max_work=100)
+    try:
+        with pytest.raises(sweepers.LimitError, match="smooth dab .* more than the limit of 1"):
+            s.apply(smooth)
+        assert voxels(s.to_pyopenvdb()) == before and not s.can_undo
+        with pytest.raises(sweepers.LimitError):
+            sweepers.Sculptor(voxel_size=1 / 32).apply(smooth)
+        sweepers.set_limits(max_memory=1e6)
+        with pytest.raises(sweepers.LimitError, match="needs about .* over its limit"):
+            sweepers.apply(RIGID)
+        with pytest.raises(ValueError):
+            sweepers.set_limits(max_work=-1)
+    finally:
+        sweepers.set_limits()
+    s.apply(smooth)
+    assert s.can_undo and voxels(s.to_pyopenvdb()) != before

@@ -8,6 +8,7 @@
 #include <openvdb/math/Stencils.h>
 #include <openvdb/tools/LevelSetRebuild.h>
 
+#include "core/limits.h"
 #include "grids.h"
 #include "io/stroke_script.h"
 #include "io/study_files.h"
@@ -205,4 +206,41 @@ TEST(Smooth, ABrushLargerThanTheShapeVisitsNoMoreThanItsLeaves) {
     const SmoothStats small = smoothLevelSet(*g, brush);
     EXPECT_LT(small.leavesVisited, g->tree().leafCount());
     EXPECT_GT(small.leaves, 0u);
+}
+
+// The limits as a test sets them, put back as they were when it ends.
+struct ScopedLimits {
+    Limits before = limits();
+    explicit ScopedLimits(const Limits& l) { setLimits(l); }
+    ~ScopedLimits() { setLimits(before); }
+    ScopedLimits(const ScopedLimits&) = delete;
+    ScopedLimits& operator=(const ScopedLimits&) = delete;
+};
+
+TEST(Smooth, ADabBeyondTheWorkLimitIsRefusedBeforeTheGridChanges) {
+    const GridPtr g = bumpySphere();
+    const GridPtr before = g->deepCopy();
+    SmoothBrush brush;
+    brush.center = Eigen::Vector3d(0.0, kR, 0.0);
+    brush.radius = kBrush;
+    brush.falloff = kFall;
+    brush.time = kSmoothTimePerRadius2 * kBrush * kBrush;
+    // What the dab takes: its steps times the voxels under the ball.
+    const SmoothStats s = smoothLevelSet(*g->deepCopy(), brush);
+    ASSERT_GT(s.updates, 1000u);
+    {
+        const ScopedLimits tight({0.0, double(s.updates) / 2});
+        try {
+            smoothLevelSet(*g, brush);
+            ADD_FAILURE() << "a dab of " << s.updates << " updates passed a limit of half that";
+        } catch (const LimitExceeded& e) {
+            EXPECT_NE(std::string(e.what()).find("more than the limit of"), std::string::npos)
+                << e.what();
+        }
+        EXPECT_EQ(test::differingBits(*g, *before), 0u);
+        EXPECT_EQ(g->tree().leafCount(), before->tree().leafCount());
+    }
+    // Within the limit (the estimate counts the voxels the flow updates), it runs.
+    const ScopedLimits enough({0.0, double(s.updates) * 1.01});
+    EXPECT_EQ(smoothLevelSet(*g, brush).updates, s.updates);
 }

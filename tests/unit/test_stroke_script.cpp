@@ -179,8 +179,21 @@ TEST(StrokeScript, BadInputIsRefusedWithFileLocationAndReason) {
              R"({"type": "pinch", "at": [0,0,0], "axis": [0,1,0], "size": 1, "falloff": 0.3, "open": -0.1})"),
          "/strokes/0/open", "must be positive"},
         {withStroke(
-             R"({"type": "pinch", "at": [0,0,0], "axis": [0,1,0], "size": 1e6, "falloff": 0.001, "open": 0.1})"),
+             R"({"type": "pinch", "at": [0,0,0], "axis": [0,1,0], "size": 1e4, "falloff": 0.001, "open": 0.1})"),
          "/strokes/0/size", "over 1000 falloffs"},
+        // Extreme values, refused before any conversion to an index or a count.
+        {withStroke(
+             R"({"type": "smooth", "tool": {"shape": "ball", "size": 1e30, "falloff": 0.1, "path": [{"t": [0, 1, 0]}]}})"),
+         "/strokes/0/tool/size", "beyond the largest number a script takes, 1e5"},
+        {withStroke(R"({"type": "inflate", "at": [0, 1, 0], "radius": 1e30})"), "/strokes/0/radius",
+         "beyond the largest number"},
+        {withStroke(R"({"type": "swirl", "at": [0, 1, 0], "move": [0, 0.1, 0], "radius": 1e30})"),
+         "/strokes/0/radius", "beyond the largest number"},
+        {withStroke(R"({"type": "fluid", "radius": 1e-300, "path": [[0, 0.85, 0], [0, 1, 0]]})"),
+         "/strokes/0/radius", "below the smallest positive number a script takes, 1e-9"},
+        {withStroke(
+             R"({"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3, "path": [{"t": [0, 1e8, 0]}, {"t": [0, 1, 0]}]}]})"),
+         "/strokes/0/tools/0/path/0/t/1", "beyond the largest number"},
         {withStroke(
              R"({"type": "strangle", "at": [0,0,0], "axis": [0,1,0], "size": 1, "falloff": 0.3})"),
          "/strokes/0/open", "missing field"},
