@@ -635,6 +635,9 @@ std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shel
 // so are its face neighbours. The signs are read as they stand, before inactive ones are
 // re-derived: where the surface moved past an inactive voxel it reads as a crossing there,
 // and the answer is no (which is only ever too cautious).
+// Rounds of sampling the voxels seedsSampled finds missing, at most.
+constexpr int kSeedRounds = 4;
+
 bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
                   const openvdb::CoordBBox& box) {
     using leafwords::Word;
@@ -672,6 +675,39 @@ bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
         }
     });
     return all;
+}
+
+// What seedsSampled finds missing, voxel by voxel (where it answered no even after the images
+// were dilated as far as the band reaches): the inactive voxels of `box` in `leaves` next to
+// the zero crossing, and the inactive face neighbours within `box` of those next to it.
+VoxelList unsampledSeeds(const Grid& grid, const std::vector<LeafNode*>& leaves,
+                         const openvdb::CoordBBox& box) {
+    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> found;
+    parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
+        const auto acc = grid.getConstAccessor();
+        auto& out = found.local();
+        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const LeafNode& leaf = *leaves[l];
+            const LeafNode::NodeMaskType crossing = crossingVoxels(leaf, acc);
+            for (auto it = crossing.beginOn(); it; ++it) {
+                const openvdb::Coord c = leaf.offsetToGlobalCoord(it.pos());
+                if (!box.isInside(c)) continue;
+                if (!leaf.isValueOn(it.pos())) out.push_back(c);
+                for (int a = 0; a < 3; ++a)
+                    for (const int d : {-1, 1}) {
+                        openvdb::Coord n = c;
+                        n[a] += d;
+                        if (box.isInside(n) && !acc.isValueOn(n)) out.push_back(n);
+                    }
+            }
+        }
+    });
+    openvdb::MaskTree marked;
+    openvdb::tree::ValueAccessor<openvdb::MaskTree, false> macc(marked);
+    for (const auto& f : found)
+        for (const openvdb::Coord& c : f)
+            macc.setValueOn(c);
+    return listLeaves(marked);
 }
 
 // Makes the leaves of `grid` within `beyond` voxels of the mask's voxels that overlap `box`,
@@ -1270,16 +1306,15 @@ void SegmentAdvector::Work::sample() {
         staged.swapInto(moving);
         stats.leavesCopied += moving.size();
     }
-    if (reach < bandReach && !seedsSampled(*grid, moving, region)) {
-        // A strong stretch spread the images apart: the images are dilated as far as the band
-        // reaches, and the voxels that adds are sampled from the same source (the leaves it
-        // adds copied first, while they still hold their tiles' values). The leaves sampled
-        // already are copied as sampling found them, their values and their active voxels,
-        // before the band grows: their old values are staged now.
-        if (!widened) from->copyAlso(moving, staged);
-        mask = dilatedByCube(mask, bandReach - reach);
-        stats.sampledReach = bandReach;
-        const VoxelList added = switchOn(mask);
+    // More voxels switched on and sampled from the same source (the leaves that adds copied
+    // first, while they still hold their tiles' values). The leaves sampled already are
+    // copied as sampling found them, their values and their active voxels, before the band
+    // grows the first time: their old values are staged now.
+    bool sourceHoldsMoving = widened != nullptr;
+    const auto sampleAlso = [&](const VoxelList& more) {
+        if (!sourceHoldsMoving) from->copyAlso(moving, staged);
+        sourceHoldsMoving = true;
+        const VoxelList added = switchOn(more);
         fresh.insert(fresh.end(), added.begin(), added.end());
         openvdb::MaskTree addedTree;
         uniteMasks(addedTree, added);
@@ -1304,6 +1339,25 @@ void SegmentAdvector::Work::sample() {
             resample(*grid, moving, *from, !widened, region, map, tearsOrFills, tornWindow,
                      options->sampling, changes(), options->interrupter, resampling, &addedTree);
         sampled = std::move(all);
+    };
+    if (reach < bandReach && !seedsSampled(*grid, moving, region)) {
+        // A strong stretch spread the images apart: the images are dilated as far as the band
+        // reaches.
+        mask = dilatedByCube(mask, bandReach - reach);
+        stats.sampledReach = bandReach;
+        sampleAlso(mask);
+        // Where even that leaves a voxel next to the new crossing unsampled (a swirl that
+        // carries a ball turns the outside deep into the shape, spreading its images farther
+        // apart than the band reaches), those voxels are sampled themselves: a few rounds at
+        // most, since each may put the crossing beside another.
+        for (int round = 0; round < kSeedRounds; ++round) {
+            const VoxelList missing = unsampledSeeds(*grid, moving, region);
+            if (missing.empty()) break;
+            VoxelList grown = mask;
+            grown.insert(grown.end(), missing.begin(), missing.end());
+            mask = eachLeafOnce(std::move(grown));
+            sampleAlso(missing);
+        }
     }
     from->freeCopies();
 }
