@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <mutex>
 
+#include "core/format.h"
 #include "core/memory.h"
 
 namespace sweepers {
@@ -32,6 +33,19 @@ double memoryLimitBytes() {
 double workLimit() {
     const Limits l = limits();
     return l.work > 0.0 ? l.work : kDefaultWork;
+}
+
+void requireMemory(double bytes, const std::string& what, const std::string& detail,
+                   const std::string& advice) {
+    const double limit = memoryLimitBytes();
+    if (limit <= 0.0 || bytes <= limit) return;
+    const std::string whose =
+        limits().memoryBytes > 0.0
+            ? "--max-memory"
+            : "half the " + formatBytes(availableMemoryBytes()) + " available";
+    throw LimitExceeded(what + " needs about " + formatBytes(bytes) + " of memory" +
+                        (detail.empty() ? "" : " (" + detail + ")") + ", over its limit of " +
+                        formatBytes(limit) + " (" + whose + "); " + advice);
 }
 
 void requireWork(double work, const std::string& what) {

@@ -36,6 +36,11 @@ Limits limits();
 double memoryLimitBytes();
 double workLimit();
 
+// Throws LimitExceeded when `bytes` exceed the memory limit: "WHAT needs about 2.9 GB of
+// memory (DETAIL), over its limit of 12.4 GB (half the 24.8 GB available); ADVICE".
+void requireMemory(double bytes, const std::string& what, const std::string& detail = "",
+                   const std::string& advice = "use a coarser voxel size or raise --max-memory");
+
 // Throws LimitExceeded when `work` voxel updates exceed the work limit: "WHAT takes about
 // 2.1e+10 voxel updates, more than the limit of 2e+09 (...)".
 void requireWork(double work, const std::string& what);

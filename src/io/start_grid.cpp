@@ -5,7 +5,6 @@
 
 #include "core/format.h"
 #include "core/limits.h"
-#include "core/memory.h"
 
 #include "io/mesh_file.h"
 #include "io/stroke_script.h"
@@ -18,19 +17,12 @@ void requireMemoryForBand(double area, double voxelSize, double halfWidth, doubl
                           bool force, const std::string& what) {
     // The band is 2 halfWidth voxels thick over the surface.
     const double voxels = area / (voxelSize * voxelSize) * 2.0 * halfWidth;
-    const double needed = voxels * bytesPerVoxel;
-    const double limit = memoryLimitBytes();
-    if (force || limit <= 0.0 || needed <= limit) return;
+    if (force) return;
     char count[32];
     std::snprintf(count, sizeof count, "%.2g", voxels);
-    const std::string whose =
-        limits().memoryBytes > 0.0
-            ? "--max-memory"
-            : "half the " + formatBytes(availableMemoryBytes()) + " available";
-    throw LimitExceeded(what + " needs about " + formatBytes(needed) + " of memory (" + count +
-                        " band voxels at voxel size " + formatNumber(voxelSize) +
-                        "), over its limit of " + formatBytes(limit) + " (" + whose +
-                        "); use a coarser voxel size, --max-memory or --force");
+    requireMemory(voxels * bytesPerVoxel, what,
+                  std::string(count) + " band voxels at voxel size " + formatNumber(voxelSize),
+                  "use a coarser voxel size, --max-memory or --force");
 }
 
 void requireSphereSize(double radius, double voxelSize) {

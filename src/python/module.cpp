@@ -160,7 +160,7 @@ auto runEngine(const py::object& progress, const std::string& what, const Work& 
 // callback.
 template <typename Read> auto withSession(const Session& session, const Read& read) {
     py::gil_scoped_release release;
-    const std::lock_guard<std::mutex> lock(session.busy());
+    const Session::Turn turn(session);
     return read(session);
 }
 
@@ -626,7 +626,7 @@ PYBIND11_MODULE(sweepers, m) {
             [](Session& s, const py::object& strokes, const py::object& progress) {
                 const std::vector<Stroke> parsed = strokesFrom(strokes);
                 runEngine(progress, "sculpting", [&](Interrupter* stop, const Progress& report) {
-                    const std::lock_guard<std::mutex> lock(s.busy());
+                    const Session::Turn turn(s);
                     s.apply(parsed, stop, report);
                     return 0;
                 });
@@ -638,7 +638,7 @@ PYBIND11_MODULE(sweepers, m) {
             "undo",
             [](Session& s) {
                 return runEngine(py::none(), "undo", [&](Interrupter*, const Progress&) {
-                    const std::lock_guard<std::mutex> lock(s.busy());
+                    const Session::Turn turn(s);
                     return s.undo();
                 });
             },
@@ -647,7 +647,7 @@ PYBIND11_MODULE(sweepers, m) {
             "redo",
             [](Session& s) {
                 return runEngine(py::none(), "redo", [&](Interrupter*, const Progress&) {
-                    const std::lock_guard<std::mutex> lock(s.busy());
+                    const Session::Turn turn(s);
                     return s.redo();
                 });
             },

@@ -169,6 +169,18 @@ bool Session::redo() {
     return true;
 }
 
+Session::Turn::Turn(const Session& session) : session_(session) {
+    if (session.holder_.load() == std::this_thread::get_id())
+        throw std::runtime_error("the Sculptor is busy with a call on this thread (a progress "
+                                 "callback cannot use the Sculptor it reports on)");
+    lock_ = std::unique_lock<std::mutex>(session.busy_);
+    session.holder_.store(std::this_thread::get_id());
+}
+
+Session::Turn::~Turn() {
+    session_.holder_.store(std::thread::id());
+}
+
 StrokeScript Session::script() const {
     return withAbsoluteFiles(document_.script(), baseDir_);
 }

@@ -3,9 +3,11 @@
 // a window). Errors are the engine's own exceptions; the bindings turn them into Python's.
 #pragma once
 
+#include <atomic>
 #include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "app/document.h"
@@ -65,12 +67,26 @@ class Session {
     // The shape now, its grid the session's own: valid until the session changes.
     Shape view() const;
     const Grid& grid() const { return document_.grid(); }
-    // Held by whoever calls the session (the Python module, around every call): one caller
-    // at a time, since sculpting rewrites the grid that readers walk.
-    std::mutex& busy() const { return busy_; }
+
+    // One caller's turn at the session, taken around every call by whoever shares it between
+    // threads (the Python module): sculpting rewrites the grid that readers walk. Waits for
+    // the turn before to end; throws std::runtime_error when this thread holds a turn already
+    // (a progress callback reading the session it reports on would wait for itself).
+    class Turn {
+      public:
+        explicit Turn(const Session& session);
+        ~Turn();
+        Turn(const Turn&) = delete;
+        Turn& operator=(const Turn&) = delete;
+
+      private:
+        const Session& session_;
+        std::unique_lock<std::mutex> lock_;
+    };
 
   private:
     mutable std::mutex busy_;
+    mutable std::atomic<std::thread::id> holder_{};
     std::string baseDir_;
     Document document_;
     ExactReference::StartFunction start_;

@@ -15,6 +15,10 @@ namespace sweepers {
 
 namespace {
 
+// Peak resident memory per band voxel of the grid an inflation leaves, while it is applied
+// (the grid, the sampled band's copies and the fill's marks), with headroom.
+constexpr double kInflationBytesPerVoxel = 400.0;
+
 // Where an inflation planned at `centre` is centred (inflate.h says why): a centre just
 // outside the surface, within the band, moves onto the surface along the normal (a few Newton
 // steps on the distance the grid holds); any other is kept.
@@ -219,6 +223,18 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                 const double rho = s.strength * s.radius;
                 const Box around = reach().expanded(2.0 * rho * (s.radial.count - 1));
                 const InflationFill fill{halfWidthOf(grid) * grid.voxelSize()[0]};
+                if (!s.remove) {
+                    // Each ball's surface joins the band: far larger a ball than the shape
+                    // makes the grid far larger than it was.
+                    const double h = grid.voxelSize()[0];
+                    const double voxels =
+                        double(grid.activeVoxelCount()) +
+                        s.radial.count * 4.0 * M_PI * rho * rho / (h * h) * 2.0 * halfWidthOf(grid);
+                    requireMemory(voxels * kInflationBytesPerVoxel,
+                                  "an inflation of radius " + formatNumber(rho),
+                                  formatNumber(voxels) + " band voxels at voxel size " +
+                                      formatNumber(h));
+                }
                 for (int k = 0; k < s.radial.count; ++k) {
                     const Eigen::Vector3d at = s.radial.turn(k) * s.at;
                     parts.push_back(std::make_unique<Inflation>(

@@ -114,5 +114,7 @@ small "a smooth dab of radius 10000" apply huge_smooth.json -o out.vdb
 small "applying the script needs about" apply "$data/studies/rigid_motion.json" -o out.vdb --voxel-size 0.000244140625
 small "needs about" study "$data/studies/rigid_motion.json" -o big_study --voxel-sizes 1/4096
 small "over its limit of 1 MB (--max-memory)" apply "$data/studies/rigid_motion.json" -o out.vdb --max-memory 0.001
+printf '{"sweepers": 1, "grid": {"voxel_size": 0.0625}, "strokes": [{"type": "inflate", "at": [0, 1, 0], "radius": 1000}]}' >huge_inflation.json
+small "an inflation of radius 1000 needs about" apply huge_inflation.json -o out.vdb
 [ ! -e out.vdb ] || fail "a refused apply wrote out.vdb"
 echo "hostile: ok"

@@ -599,3 +599,10 @@ def test_work_past_the_limits_is_refused_and_changes_nothing():
         sweepers.set_limits()
     s.apply(smooth)
     assert s.can_undo and voxels(s.to_pyopenvdb()) != before
+
+
+def test_a_progress_callback_reading_its_own_sculptor_is_told_not_deadlocked():
+    s = sweepers.Sculptor(voxel_size=1 / 32)
+    with pytest.raises(RuntimeError, match="busy with a call on this thread"):
+        s.apply(STROKES[0], progress=lambda done, total: s.volume)
+    assert s.script()["strokes"] == [] and not s.can_undo
