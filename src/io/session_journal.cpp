@@ -61,8 +61,11 @@ void JournalWriter::start(const std::string& dir, const StrokeScript& script,
     if (fd_ >= 0) ::close(fd_);
     fd_ = -1;
     path_ = journalPath(dir);
+    // (A document made in code may name no directory: its files are named absolutely, or
+    // relative to where the program runs.)
+    const fs::path base = scriptDir.empty() ? fs::current_path() : fs::absolute(scriptDir);
     const json header = {{"session", 1},
-                         {"dir", fs::absolute(scriptDir).lexically_normal().string()},
+                         {"dir", base.lexically_normal().string()},
                          {"script", json::parse(formatStrokeScript(script, -1))}};
     writeTextAtomically(path_, header.dump() + "\n");
     fd_ = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);

@@ -22,6 +22,7 @@
 #include <tbb/task_arena.h>
 
 #include "app/document.h"
+#include "app/session.h"
 #include "coarse.h"
 #include "grids.h"
 #include "io/start_grid.h"
@@ -46,8 +47,8 @@ std::size_t envCount(const char* name, std::size_t fallback) {
 }
 
 // The properties, in the order they are checked.
-const std::vector<std::string> kProperties = {"valid", "runs",     "undo",    "redo",
-                                              "band",  "topology", "threads", "peer"};
+const std::vector<std::string> kProperties = {"valid",    "runs",    "undo", "redo",   "band",
+                                              "topology", "threads", "peer", "journal"};
 
 struct Failure {
     std::string property, detail;
@@ -80,6 +81,14 @@ class HistoryCheck {
         StrokeScript start = script;
         start.strokes.clear();
         Document doc(start, dir_);
+        // The crash journal the modeler keeps of the same edits, with a checkpoint every
+        // two strokes (what a recovery replays from).
+        test::ScratchDir sessions;
+        SessionOptions so;
+        so.root = sessions.path.string();
+        so.checkpointStrokes = 2;
+        auto session = std::make_unique<Session>(so);
+        session->follow(doc);
         for (std::size_t i = 0; i < script.strokes.size(); ++i) {
             const Stroke& stroke = script.strokes[i];
             const GridPtr before = doc.grid().deepCopy();
@@ -102,6 +111,19 @@ class HistoryCheck {
             if (euler != eulerBefore && !changesTopology(stroke))
                 fail("topology", at(i) + "Euler characteristic " + std::to_string(eulerBefore) +
                                      " -> " + std::to_string(euler));
+        }
+        // The journal, left on disk as a crash leaves it, recovers the same grid.
+        session->flush();
+        const std::string journalError = session->takeError(), sessionDir = session->dir();
+        doc.setHistoryListener(nullptr);
+        session.reset();
+        if (!journalError.empty()) {
+            fail("journal", journalError);
+        } else {
+            Adoption adopt;
+            const std::unique_ptr<Document> recovered = recoverDocument(sessionDir, adopt);
+            if (const std::size_t d = test::differingBits(recovered->grid(), doc.grid()))
+                fail("journal", "the recovered grid: " + std::to_string(d) + " voxels differ");
         }
         // The same history in one go, on 1 and 3 threads: the same grid, to the bit (the
         // coarse set, on 1 only: the document ran on the machine's threads).
