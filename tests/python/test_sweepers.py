@@ -482,7 +482,7 @@ def test_the_engine_releases_the_gil():
 
 def test_threads_sharing_a_sculptor_take_turns():
     # Two or more threads sculpting one Sculptor crashed or hung (the engine runs without the
-    # GIL): each call now waits for the one using it. Four threads apply strokes, two read
+    # GIL): each call now waits for the one using it. Three threads apply strokes, two read
     # it meanwhile, and two more sculpt Sculptors of their own.
     shared = sweepers.Sculptor(voxel_size=1 / 32)
     own = [sweepers.Sculptor(voxel_size=1 / 32) for _ in range(2)]
@@ -497,22 +497,22 @@ def test_threads_sharing_a_sculptor_take_turns():
         return run
 
     def sculpt(first):
-        for k in range(4):
+        for k in range(3):
             shared.apply(STROKES[(first + k) % len(STROKES)])
             sculpting.set()
 
     def read():
         sculpting.wait()
-        for _ in range(20):
+        for _ in range(10):
             shared.sample(np.zeros((8, 3)))
             assert shared.topology["components"] >= 1 and shared.volume > 0
             shared.can_undo, shared.script()
 
     def alone(s):
-        for stroke in STROKES[:3]:
+        for stroke in STROKES[:2]:
             s.apply(stroke)
 
-    threads = ([threading.Thread(target=guarded(lambda f=f: sculpt(f))) for f in (0, 2, 5, 7)]
+    threads = ([threading.Thread(target=guarded(lambda f=f: sculpt(f))) for f in (0, 3, 7)]
                + [threading.Thread(target=guarded(read)) for _ in range(2)]
                + [threading.Thread(target=guarded(lambda s=s: alone(s))) for s in own])
     for t in threads:
@@ -520,14 +520,14 @@ def test_threads_sharing_a_sculptor_take_turns():
     for t in threads:
         t.join(timeout=600)
     assert not any(t.is_alive() for t in threads) and errors == []
-    # Sixteen whole strokes, one after another: the session's script replays to its grid.
+    # Nine whole strokes, one after another: the session's script replays to its grid.
     script = shared.script()
-    assert len(script["strokes"]) == 16
+    assert len(script["strokes"]) == 9
     assert voxels(sweepers.apply(script).to_pyopenvdb()) == voxels(shared.to_pyopenvdb())
     for s in own:
         assert voxels(s.to_pyopenvdb()) == voxels(sweepers.apply(s.script()).to_pyopenvdb())
     # Undo takes back the strokes one call at a time, from any thread.
-    undo = [threading.Thread(target=shared.undo) for _ in range(16)]
+    undo = [threading.Thread(target=shared.undo) for _ in range(9)]
     for t in undo:
         t.start()
     for t in undo:
