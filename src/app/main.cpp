@@ -9,6 +9,7 @@
 
 #include "app/input_replay.h"
 #include "app/modeler.h"
+#include "core/limits.h"
 #include "core/memory.h"
 #include "io/stroke_script.h"
 
@@ -66,6 +67,15 @@ static int run(int argc, char** argv) {
         ->check(CLI::Range(0.0, 1e7));
     app.add_option("--threads", threads, "worker threads (default: all cores)")
         ->check(CLI::Range(1, 1024));
+    // As sweepers-cli's: a stroke past them is refused, its message in the status line.
+    double maxMemoryGb = 0.0, maxWork = 0.0;
+    app.add_option("--max-memory", maxMemoryGb,
+                   "refuse a stroke estimated to need more memory, in GB (default: half the "
+                   "memory available)")
+        ->check(CLI::PositiveNumber);
+    app.add_option("--max-work", maxWork,
+                   "refuse a stroke estimated to take more voxel updates (default 2e9)")
+        ->check(CLI::PositiveNumber);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -74,6 +84,7 @@ static int run(int argc, char** argv) {
         return app.exit(e) == 0 ? 0 : 2;
     }
     o.undoBudgetBytes = std::size_t(undoMb * 1024 * 1024);
+    sweepers::setLimits({maxMemoryGb * 1e9, maxWork});
     try {
         if (!script.empty()) {
             if (!o.open.empty()) throw std::runtime_error("give either a file or --script");

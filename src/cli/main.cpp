@@ -65,18 +65,23 @@ json vec(const Eigen::Vector3d& v) {
     return json::array({v.x(), v.y(), v.z()});
 }
 
+// An option's number: the whole text, NaN where it is none.
+double numberIn(const std::string& text) {
+    try {
+        std::size_t used = 0;
+        const double v = std::stod(text, &used);
+        if (used == text.size()) return v;
+    } catch (const std::exception&) {
+    }
+    return std::nan("");
+}
+
 // A positive finite number, at most `most`, said in words (CLI11's own range check prints
 // its bounds in seventeen digits).
 CLI::Validator positiveNumber(double most = std::numeric_limits<double>::max()) {
     return CLI::Validator(
         [most](std::string& text) -> std::string {
-            double v = 0.0;
-            try {
-                std::size_t used = 0;
-                v = std::stod(text, &used);
-                if (used != text.size()) v = 0.0;
-            } catch (const std::exception&) {
-            }
+            const double v = numberIn(text);
             if (v > 0.0 && v <= most) return "";
             return "must be a positive number" +
                    (most < std::numeric_limits<double>::max() ? " of at most " + formatNumber(most)
@@ -84,6 +89,16 @@ CLI::Validator positiveNumber(double most = std::numeric_limits<double>::max()) 
                    ", not " + text;
         },
         "POSITIVE");
+}
+
+// A number within core/limits.h's range, as a script's numbers are.
+CLI::Validator scriptNumber() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            if (std::abs(numberIn(text)) <= kLargestNumber) return "";
+            return "must be a number within 1e5 of zero, not " + text;
+        },
+        "NUMBER");
 }
 
 // An error: one line on stderr and, with --json, the same on stdout as {"error": ..., "exit":
@@ -707,20 +722,7 @@ static int run(int argc, char** argv) {
     CLI::App* create = app.add_subcommand("new", "Write a sphere level set");
     create->add_option("-o,--output", output, "Output .vdb")->required();
     create->add_option("--radius", radius, "Sphere radius")->check(positiveNumber());
-    create->add_option("--center", center, "Sphere centre")
-        ->expected(3)
-        ->check(CLI::Validator(
-            [](std::string& text) -> std::string {
-                // As a script's numbers (io/stroke_script.cpp): finite, within 1e5.
-                try {
-                    std::size_t used = 0;
-                    const double v = std::stod(text, &used);
-                    if (used == text.size() && std::abs(v) <= 1e5) return "";
-                } catch (const std::exception&) {
-                }
-                return "must be a number within 1e5 of zero, not " + text;
-            },
-            "NUMBER"));
+    create->add_option("--center", center, "Sphere centre")->expected(3)->check(scriptNumber());
     create->add_option("--voxel-size", voxelSize, "Voxel size")->check(positiveNumber());
     create->add_option("--half-width", halfWidth, "Band half-width in voxels")
         ->check(CLI::Range(2.0, 64.0));

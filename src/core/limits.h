@@ -22,6 +22,12 @@ struct Limits {
     double work = 0.0;        // voxel updates per deformation or dab; 0: kDefaultWork
 };
 
+// Every number of a script (a length, a time, an angle, a strength) and every coordinate a
+// shape may reach lies within kLargestNumber of zero, and every positive number of a script
+// is at least kSmallestPositive: far beyond a shape's scale, but within what converts to a
+// voxel index or a step count without overflow, and where a float still places a voxel.
+constexpr double kLargestNumber = 1e5, kSmallestPositive = 1e-9;
+
 // About a minute of smoothing flow on one core, several of sub-steps through a fluid's
 // sampled field: beyond it a stroke is more likely a slip (a fluid ball of radius 0.01 sent
 // a thousand units away) than a wish.

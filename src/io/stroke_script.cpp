@@ -16,6 +16,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/format.h"
+#include "core/limits.h"
 #include "io/atomic_file.h"
 #include "io/baked_tool.h"
 #include "io/fluid_cache.h"
@@ -97,12 +98,8 @@ class Reader {
         return *it;
     }
 
-    // Every number of a script (a length, a time, an angle, a strength) lies within
-    // kLargestNumber of zero, and every positive one at least kSmallestPositive from it: far
-    // beyond a shape's scale, but within what converts to a voxel index or a step count
-    // without overflow (a size of 1e30 once made strokes that silently did nothing).
-    static constexpr double kLargestNumber = 1e5, kSmallestPositive = 1e-9;
-
+    // Within core/limits.h's range (a size of 1e30 once made strokes that silently did
+    // nothing).
     double number(const json& v, const std::string& where) const {
         if (!v.is_number()) fail(where, "expected a number, got " + describe(v));
         const double d = v.get<double>();

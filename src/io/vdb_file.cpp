@@ -9,6 +9,7 @@
 #include <openvdb/io/Stream.h>
 
 #include "core/format.h"
+#include "core/limits.h"
 #include "io/atomic_file.h"
 #include "io/isolated_read.h"
 #include "levelset/create.h"
@@ -40,7 +41,7 @@ std::string unusable(const Grid& grid) {
     if (!box.empty()) {
         const openvdb::Vec3d lo = grid.indexToWorld(box.min()), hi = grid.indexToWorld(box.max());
         for (int a = 0; a < 3; ++a)
-            if (!(std::max(std::abs(lo[a]), std::abs(hi[a])) <= 1e5))
+            if (!(std::max(std::abs(lo[a]), std::abs(hi[a])) <= kLargestNumber))
                 return "lies beyond 1e5 of the origin, farther than Sweepers sculpts";
     }
     const double hw = halfWidthOf(grid);

@@ -185,6 +185,16 @@ print(f"habits: {len(smooth)} smooth dabs, a deflation (scale {deflate}), clay a
 PY
 "$cli" apply "$tmp/habits.json" -o "$tmp/habits_replayed.vdb" -q
 "$py" "$here/same_grid.py" "$tmp/habits.vdb" "$tmp/habits_replayed.vdb"
+# The same hands under a work limit no smooth dab fits: the dabs are refused (the status
+# line says why), every other stroke is kept.
+run --replay-input "$here/artist_habits.json" --max-work 1000 --save-script "$tmp/limited.json"
+"$py" - "$tmp/habits.json" "$tmp/limited.json" <<'PY'
+import json, sys
+full, limited = ([s["type"] for s in json.load(open(p))["strokes"]] for p in sys.argv[1:3])
+assert "smooth" not in limited and limited == [k for k in full if k != "smooth"], (full, limited)
+print(f"habits under --max-work 1000: {len(full) - len(limited)} smooth dabs refused, "
+      f"{len(limited)} strokes kept")
+PY
 
 # --- two strokes, undo both, redo one: the grid after the first stroke, exactly --------
 run --replay-input "$here/drag_ab_undo.json" --save "$tmp/undo.vdb" --save-script "$tmp/undo.json"

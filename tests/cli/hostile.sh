@@ -94,6 +94,19 @@ printf '{"sweepers": 1, "grid": {"voxel_size": 0.1}, "start": {"vdb": "float_siz
 "$cli" -q apply float_size.json -o float_out.vdb || fail "a float voxel size of 0.1 was refused"
 printf '{"sweepers": 1, "grid": {"voxel_size": 0.1000001}, "start": {"vdb": "float_size.vdb"}, "strokes": []}' >other_size.json
 refused 1 "its voxel size 0.100000001" apply other_size.json -o out.vdb
+# An inflation far larger than the shape gives what the thesis's inflation gives: its ball,
+# the unit sphere's clay on it, one part of genus 0 (radius 10 once gave genus 73).
+printf '{"sweepers": 1, "grid": {"voxel_size": 0.0625}, "strokes": [{"type": "inflate", "at": [0, 1, 0], "radius": 5}]}' >big_ball.json
+"$cli" -q apply big_ball.json -o big_ball.vdb
+"$cli" info --json big_ball.vdb | "$py" -c '
+import json, math, sys
+info = json.load(sys.stdin)
+exact = 4 / 3 * math.pi * (5 ** 3 + 1)  # the ball and the sphere it swallowed
+assert info["components"] == 1 and info["genus"] == 0, info
+assert abs(info["mesh_volume"] - exact) < 1e-3 * exact, (info["mesh_volume"], exact)
+volume = info["mesh_volume"]
+print(f"an inflation of radius 5 on the unit sphere: one part, genus 0, volume {volume:.2f} of {exact:.2f}")'
+
 # Work and memory past the limits are refused by estimate, before anything is allocated:
 # each refusal's peak memory stays that of a small process.
 small() { # small MESSAGE ARGS...: refused with exit 1, naming MESSAGE, under 300 MB
