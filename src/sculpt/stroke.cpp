@@ -15,8 +15,8 @@ namespace sweepers {
 
 namespace {
 
-// Peak resident memory per band voxel of the grid an inflation leaves, while it is applied
-// (the grid, the sampled band's copies and the fill's marks), with headroom.
+// Peak resident memory per band voxel an inflation adds, while it is applied (the new band,
+// the sampled band's copies and the fill's marks), with headroom.
 constexpr double kInflationBytesPerVoxel = 400.0;
 
 // Where an inflation planned at `centre` is centred (inflate.h says why): a centre just
@@ -225,10 +225,10 @@ std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const
                 const InflationFill fill{halfWidthOf(grid) * grid.voxelSize()[0]};
                 if (!s.remove) {
                     // Each ball's surface joins the band: far larger a ball than the shape
-                    // makes the grid far larger than it was.
+                    // makes the grid far larger than it was. (The grid there is already has
+                    // its memory.)
                     const double h = grid.voxelSize()[0];
                     const double voxels =
-                        double(grid.activeVoxelCount()) +
                         s.radial.count * 4.0 * M_PI * rho * rho / (h * h) * 2.0 * halfWidthOf(grid);
                     requireMemory(voxels * kInflationBytesPerVoxel,
                                   "an inflation of radius " + formatNumber(rho),
