@@ -606,3 +606,25 @@ def test_a_progress_callback_reading_its_own_sculptor_is_told_not_deadlocked():
     with pytest.raises(RuntimeError, match="busy with a call on this thread"):
         s.apply(STROKES[0], progress=lambda done, total: s.volume)
     assert s.script()["strokes"] == [] and not s.can_undo
+
+
+def test_generated_histories_give_one_grid_stroke_by_stroke_and_whole(tmp_path):
+    # Histories nobody wrote (the test suite's generator, tests/unit/random_history.h): a
+    # Sculptor applying them a stroke at a time, sweepers.apply and sweepers-cli apply give the
+    # same grid, to the bit.
+    subprocess.run([os.environ["SWEEPERS_HISTORY_TESTS"], "--gtest_also_run_disabled_tests",
+                    "--gtest_filter=RandomHistories.DISABLED_WriteScripts"],
+                   env={**CLI_ENV, "SWEEPERS_HISTORY_SCRIPTS": str(tmp_path),
+                        "SWEEPERS_HISTORIES": "3"}, check=True, capture_output=True)
+    scripts = sorted(tmp_path.glob("history_*.json"))
+    assert len(scripts) == 3
+    for path in scripts:
+        script = json.load(open(path))
+        s = sweepers.Sculptor(start=script.get("start"), voxel_size=script["grid"]["voxel_size"])
+        for stroke in script["strokes"]:
+            s.apply(stroke)
+        cli("apply", str(path), "-o", str(tmp_path / "cli.vdb"), "-q")
+        by_cli = voxels(vdb.read(str(tmp_path / "cli.vdb"), "surface"))
+        assert voxels(s.to_pyopenvdb()) == by_cli, path.name
+        assert voxels(sweepers.apply(str(path)).to_pyopenvdb()) == by_cli, path.name
+        print(f"{path.name}: {len(script['strokes'])} strokes, {len(by_cli)} voxels alike")

@@ -194,9 +194,11 @@ json shrink(json history, const std::string& property, const std::string& dir) {
 
 // The start files the histories may name, made once.
 struct StartFiles {
-    test::ScratchDir dir;
+    test::ScratchDir scratch;
     std::string vdb, mesh;
-    explicit StartFiles(double voxelSize) {
+    // In a scratch directory removed after, or in `into`.
+    explicit StartFiles(double voxelSize, const std::filesystem::path& into = {}) {
+        const std::filesystem::path dir = into.empty() ? scratch.path : into;
         // An ellipsoid as a level set, and a rounded box as a mesh (its edges are creases
         // the grid does not resolve: the report must say so).
         const int n = int(std::ceil(1.3 / voxelSize));
@@ -224,6 +226,20 @@ struct StartFiles {
     }
 };
 
+// The histories' options: the CI set's (coarse) or the full one.
+test::HistoryOptions optionsFor(bool coarse) {
+    test::HistoryOptions options;
+    if (coarse) {
+        options.coarsest = 32;
+        options.finest = 36;
+        options.fewestStrokes = 3;
+        options.mostStrokes = 4;
+        options.tearShare = 0.02;
+    }
+    options.vdbVoxelSize = 2.0 / (options.coarsest + options.finest);
+    return options;
+}
+
 } // namespace
 
 // (Outside the anonymous namespace: the tests GoogleTest derives from it are not in it.)
@@ -239,15 +255,7 @@ TEST_P(RandomHistories, HoldEveryProperty) {
                       count = all * std::size_t(GetParam() + 1) / kShards - first;
     const unsigned seed = unsigned(envCount("SWEEPERS_HISTORY_SEED", 1) + first);
     const bool strict = envCount("SWEEPERS_HISTORY_STRICT", 0) != 0;
-    test::HistoryOptions options;
-    if (coarse) {
-        options.coarsest = 32;
-        options.finest = 36;
-        options.fewestStrokes = 3;
-        options.mostStrokes = 4;
-        options.tearShare = 0.02;
-    }
-    options.vdbVoxelSize = 2.0 / (options.coarsest + options.finest);
+    test::HistoryOptions options = optionsFor(coarse);
     const StartFiles starts(options.vdbVoxelSize);
     options.vdbStart = starts.vdb;
     options.meshStart = starts.mesh;
@@ -284,6 +292,24 @@ TEST_P(RandomHistories, HoldEveryProperty) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Shard, RandomHistories, ::testing::Range(0, kShards));
+
+// The CI set's first histories as scripts, with their start files, in
+// $SWEEPERS_HISTORY_SCRIPTS (history_<seed>.json): the Python module's test applies them
+// through a Sculptor (tests/python). Run by that test only (--gtest_also_run_disabled_tests).
+TEST(RandomHistories, DISABLED_WriteScripts) {
+    const char* out = std::getenv("SWEEPERS_HISTORY_SCRIPTS");
+    ASSERT_TRUE(out && *out) << "SWEEPERS_HISTORY_SCRIPTS names no directory";
+    test::HistoryOptions options = optionsFor(true);
+    const StartFiles starts(options.vdbVoxelSize, out);
+    options.vdbStart = starts.vdb;
+    options.meshStart = starts.mesh;
+    const unsigned seed = unsigned(envCount("SWEEPERS_HISTORY_SEED", 1));
+    for (std::size_t i = 0; i < envCount("SWEEPERS_HISTORIES", 6); ++i) {
+        const unsigned s = seed + unsigned(i);
+        std::ofstream(std::string(out) + "/history_" + std::to_string(s) + ".json")
+            << test::HistoryGenerator(s, options).script().dump(2) << '\n';
+    }
+}
 
 // The histories the generator found failing, shrunk, and fixed since: each holds the
 // property it was shrunk for (its file name's last word) and every property asserted above.
