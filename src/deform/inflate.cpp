@@ -44,10 +44,14 @@ ForwardResult Inflation::forwardStep(int, const Eigen::Vector3d& q, double) cons
     return {remove_ ? suckIn(q) : blowUp(q), true, 1};
 }
 
+bool Inflation::fillsWith(double fromValue) const {
+    // Deeper than half the band, the thesis's ball meets the pushed surface well enough.
+    return fills_ && fromValue > -0.5 * fill_.band && fromValue < fill_.band;
+}
+
 double Inflation::filledValue(const Eigen::Vector3d& x, double value, double fromValue) const {
     const double band = fill_.band;
-    // Deeper than half the band, the thesis's ball meets the pushed surface well enough.
-    if (!fills_ || fromValue <= -0.5 * band || fromValue >= band) return value;
+    if (!fillsWith(fromValue)) return value;
     const double s = std::max(0.0, -fromValue);
     const double r = (x - c_).norm(), out = r - std::cbrt(rho3_ + s * s * s);
     if (r < rho_) return std::max(out, -band); // the new ball: clay

@@ -53,6 +53,7 @@ class Inflation : public StepDeformation {
     ForwardResult forwardStep(int k, const Eigen::Vector3d& q,
                               double tolerance = 0.0) const override;
     Eigen::Vector3d filledFrom() const override { return c_; }
+    bool fillsWith(double fromValue) const override;
     double filledValue(const Eigen::Vector3d& x, double value, double fromValue) const override;
     Box filledBox() const override;
 

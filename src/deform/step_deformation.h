@@ -113,9 +113,11 @@ class StepDeformation {
     // has one sub-step). Then the value sampled at x, at its pre-image, becomes
     // filledValue(x, value, fromValue), fromValue the value at filledFrom() before the
     // deformation: a distance to the new surface rather than one value across the region.
-    // filledBox() holds every point where filledValue differs from the value it is given.
+    // filledBox() holds every point where filledValue differs from the value it is given;
+    // where fillsWith(fromValue) is false, it differs nowhere.
     bool fills() const { return fills_; }
     virtual Eigen::Vector3d filledFrom() const { return Eigen::Vector3d::Zero(); }
+    virtual bool fillsWith(double /*fromValue*/) const { return false; }
     virtual double filledValue(const Eigen::Vector3d& /*x*/, double value,
                                double /*fromValue*/) const {
         return value;

@@ -388,6 +388,18 @@ using ResampleScratches = tbb::enumerable_thread_specific<ResampleScratch>;
 // which stretches the space around the set by orders of magnitude, would spread that over
 // the rim of the hole.
 //
+// The value a filling deformation's region is made from: at its filledFrom(), before the
+// deformation, sampled as `sampling` samples every voxel.
+double filledFromValue(const SampleSource& source, const Grid& grid, const StepDeformation& seg,
+                       Sampling sampling) {
+    const SampleSource::Accessor acc(source);
+    const openvdb::Vec3d p = VoxelPlacement(grid.transform()).toIndex(toVdb(seg.filledFrom()));
+    const float reach = float(kCorrectedReach * grid.voxelSize()[0]);
+    return sampling == Sampling::MonotoneCubic ? sampleMonotoneCubic(acc, p)
+           : sampling == Sampling::Corrected   ? acc.corrected(p, reach)
+                                               : acc.trilinear(p);
+}
+
 // A deformation that fills what has no pre-image (`seg` with fills(): an inflation's ball)
 // turns the value sampled there into its filled value. `seg` is the deformation when it
 // tears or fills, else null.
@@ -404,18 +416,11 @@ std::size_t resample(Grid& grid, const std::vector<LeafNode*>& leaves, const Sam
     std::atomic<std::size_t> count{0};
     const VoxelPlacement place(grid.transform());
     const StepDeformation* tearing = seg && seg->tears() ? seg : nullptr;
-    const StepDeformation* filling = seg && seg->fills() ? seg : nullptr;
+    const double fromValue =
+        seg && seg->fills() ? filledFromValue(source, grid, *seg, sampling) : 0.0;
+    // (Where the fill does not apply, no voxel looks at it.)
+    const StepDeformation* filling = seg && seg->fillsWith(fromValue) ? seg : nullptr;
     const Box filledBox = filling ? filling->filledBox() : Box();
-    // The value the filled region is made from, sampled as every voxel is.
-    double fromValue = 0.0;
-    if (filling) {
-        const SampleSource::Accessor acc(source);
-        const openvdb::Vec3d p = place.toIndex(toVdb(filling->filledFrom()));
-        const float reach = float(kCorrectedReach * grid.voxelSize()[0]);
-        fromValue = sampling == Sampling::MonotoneCubic ? sampleMonotoneCubic(acc, p)
-                    : sampling == Sampling::Corrected   ? acc.corrected(p, reach)
-                                                        : acc.trilinear(p);
-    }
     const bool windowPastRim = tearing && tearing->windowPastRim();
     const double h = grid.voxelSize()[0];
     const float reach = float(kCorrectedReach * h), seedReach = float(kSeedValues * h);
@@ -615,13 +620,14 @@ std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shel
 // grown around the images of the surface: no surface maps into the region it fills, whose
 // edge may be new surface. The voxels there whose filled value lies within `shell` of the
 // surface join the band; they enclose the rest of the region, whose signs the flood after
-// sampling re-derives.
+// sampling re-derives. Nothing is marked where the fill does not apply (a dab of clay well
+// inside the shape, as the modeler places it): its ball's box is not walked.
 std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shell,
-                       VoxelList& mask) {
-    const openvdb::CoordBBox box = indexBox(grid, seg.filledBox(), 1);
+                       Sampling sampling, VoxelList& mask) {
     const SampleSource source(grid, Grid::create());
-    const double from =
-        SampleSource::Accessor(source).trilinear(grid.worldToIndex(toVdb(seg.filledFrom())));
+    const double from = filledFromValue(source, grid, seg, sampling);
+    if (!seg.fillsWith(from)) return 0;
+    const openvdb::CoordBBox box = indexBox(grid, seg.filledBox(), 1);
     const auto needed = [&](const Eigen::Vector3d& x, float, const SampleSource::Accessor& acc) {
         const double at = acc.trilinear(grid.worldToIndex(toVdb(seg.inverseMap(x))));
         const double filled = seg.filledValue(x, at, from);
@@ -635,9 +641,6 @@ std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shel
 // so are its face neighbours. The signs are read as they stand, before inactive ones are
 // re-derived: where the surface moved past an inactive voxel it reads as a crossing there,
 // and the answer is no (which is only ever too cautious).
-// Rounds of sampling the voxels seedsSampled finds missing, at most.
-constexpr int kSeedRounds = 4;
-
 bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
                   const openvdb::CoordBBox& box) {
     using leafwords::Word;
@@ -676,6 +679,9 @@ bool seedsSampled(const Grid& grid, const std::vector<LeafNode*>& leaves,
     });
     return all;
 }
+
+// Rounds of sampling the voxels seedsSampled finds missing, at most.
+constexpr int kSeedRounds = 4;
 
 // What seedsSampled finds missing, voxel by voxel (where it answered no even after the images
 // were dilated as far as the band reaches): the inactive voxels of `box` in `leaves` next to
@@ -1213,7 +1219,8 @@ void SegmentAdvector::Work::growBand() {
     // (renormalization drops them again, with their new sign).
     if (seg->tears()) stats.tornVoxels = markOpened(*grid, *seg, (halfWidth + 2) * h, mask);
     // An inflation fills its ball: no image of the surface reaches its edge either.
-    if (seg->fills()) stats.filledVoxels = markFilled(*grid, *seg, (halfWidth + 2) * h, mask);
+    if (seg->fills())
+        stats.filledVoxels = markFilled(*grid, *seg, (halfWidth + 2) * h, options->sampling, mask);
     fresh = switchOn(mask);
 }
 

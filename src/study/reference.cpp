@@ -32,6 +32,9 @@ ExactReference::ExactReference(StartFunction start) : start_(std::move(start)) {
 void ExactReference::append(std::shared_ptr<const StepDeformation> deformation) {
     if (!deformation) throw std::invalid_argument("ExactReference::append: no deformation");
     fills_ = fills_ || deformation->fills();
+    // A fill's value at its centre before it, computed once: every point it fills reads it.
+    fromValues_.push_back(
+        deformation->fills() ? valueThrough(history_.size(), deformation->filledFrom()) : 0.0);
     history_.push_back(std::move(deformation));
 }
 
@@ -72,8 +75,7 @@ double ExactReference::valueThrough(std::size_t n, const Eigen::Vector3d& x) con
     for (auto it = turns.rbegin(); it != turns.rend(); ++it) {
         const StepDeformation& seg = *history_[it->first];
         if (seg.tears()) v += std::max(0.0, seg.openedDepth(it->second));
-        if (seg.fills())
-            v = seg.filledValue(it->second, v, valueThrough(it->first, seg.filledFrom()));
+        if (seg.fills()) v = seg.filledValue(it->second, v, fromValues_[it->first]);
     }
     return v;
 }

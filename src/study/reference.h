@@ -51,7 +51,8 @@ class ExactReference {
 
     StartFunction start_;
     std::vector<std::shared_ptr<const StepDeformation>> history_;
-    bool fills_ = false; // whether a deformation of the history fills a region
+    std::vector<double> fromValues_; // per deformation: the value a fill is made from, or 0
+    bool fills_ = false;             // whether a deformation of the history fills a region
 };
 
 } // namespace sweepers
