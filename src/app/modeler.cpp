@@ -755,6 +755,13 @@ class Modeler {
         if (ImGui::SliderFloat("strength  shift F", &strength, 0.01f, 1.0f, "%.2f"))
             s.strength = std::clamp(double(strength), 0.01, 1.0);
         mustFit("strength  shift F");
+        // Smoothing's own strength (Shift-drag uses it whatever the tool): past 1 it reaches
+        // the form, not only the noise.
+        float smooth = float(s.smoothStrength);
+        if (ImGui::SliderFloat("smooth strength", &smooth, 0.1f, float(kMostSmoothStrength), "%.2f",
+                               ImGuiSliderFlags_Logarithmic))
+            s.smoothStrength = std::clamp(double(smooth), 0.01, kMostSmoothStrength);
+        mustFit("smooth strength");
         int mirror = int(s.mirror);
         ImGui::Combo("mirror (M)", &mirror, "none\0x\0y\0z\0");
         mustFit("mirror (M)");

@@ -244,7 +244,7 @@ void SculptController::smoothDab(const glm::dvec3& p) {
     SmoothStroke stroke;
     stroke.tool.size = Eigen::Vector3d::Constant(settings_.radius);
     stroke.tool.falloff = settings_.falloff;
-    stroke.strength = settings_.strength;
+    stroke.strength = settings_.smoothStrength;
     stroke.radial = radial();
     Placement at;
     at.t = toEigen3(p);
@@ -297,7 +297,7 @@ KeyAction SculptController::onKey(int key, bool ctrl, bool shift) {
     if (!doc_) return KeyAction::None;
     if (key == GLFW_KEY_ESCAPE) {
         if (sizing_ != Sizing::None) {
-            (sizing_ == Sizing::Radius ? settings_.radius : settings_.strength) = sizingFrom_;
+            (sizing_ == Sizing::Radius ? settings_.radius : sizedStrength()) = sizingFrom_;
             sizing_ = Sizing::None;
             return KeyAction::None;
         }
@@ -400,7 +400,7 @@ void SculptController::beginSizing(Sizing what) {
     sizingX_ = cursorX_;
     sizingY_ = cursorY_;
     sizingAt_ = pick(cursorX_, cursorY_).value_or(camera_.target);
-    sizingFrom_ = what == Sizing::Radius ? settings_.radius : settings_.strength;
+    sizingFrom_ = what == Sizing::Radius ? settings_.radius : sizedStrength();
 }
 
 void SculptController::moveSizing(double x, double y) {
@@ -409,9 +409,15 @@ void SculptController::moveSizing(double x, double y) {
             camera_.dragInViewPlane(sizingAt_, sizingX_, sizingY_, x, y, width_, height_);
         settings_.radius = std::clamp(glm::length(w), 0.02, 2.0);
     } else {
+        // A fifth of the window's height is full strength: 1, or the smooth tool's most.
         const double pixels = std::hypot(x - sizingX_, y - sizingY_);
-        settings_.strength = std::clamp(pixels / (0.2 * height_), 0.01, 1.0);
+        const double most = mode_ == SculptMode::Smooth ? kMostSmoothStrength : 1.0;
+        sizedStrength() = std::clamp(most * pixels / (0.2 * height_), 0.01, most);
     }
+}
+
+double& SculptController::sizedStrength() {
+    return mode_ == SculptMode::Smooth ? settings_.smoothStrength : settings_.strength;
 }
 
 std::optional<glm::dvec3> SculptController::toolCentre() const {

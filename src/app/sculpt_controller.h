@@ -60,6 +60,9 @@ struct ToolSettings {
     // (0, 1]: the fraction of the hand's motion a grab, twist, inflate or fluid applies, of
     // a swirl's move, of the clay ball's radius, of a smooth dab's flow time.
     double strength = 1.0;
+    // (0, kMostSmoothStrength]: a smooth dab's flow time over the default dab's (Shift-drag
+    // smooths with it whatever the tool; a smooth dab is cheap enough to reach the form).
+    double smoothStrength = 1.0;
     // Radial symmetry: `radialCount` copies of a grab, twist or inflate tool (and of each
     // swirl ring and dab of clay or smoothing) turned about the axis `radialAxis` (0 x, 1 y,
     // 2 z) through the origin; 1 is the tool alone.
@@ -178,6 +181,8 @@ class SculptController {
     RadialSymmetry radial() const;
     void beginSizing(Sizing what);
     void moveSizing(double x, double y);
+    // The strength Shift-F sets: the smooth tool's own, or every other tool's.
+    double& sizedStrength();
     void finishDrag();
     bool topologyMode() const {
         return mode_ == SculptMode::Pinch || mode_ == SculptMode::Strangle;

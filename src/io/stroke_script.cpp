@@ -256,11 +256,14 @@ ToolSpec readTool(const Reader& r, const json& v, const std::string& at,
 }
 
 // A stroke's "strength": a fraction in (0, 1], 1 when not given.
-double readStrength(const Reader& r, const json& v, const std::string& at) {
+double readStrength(const Reader& r, const json& v, const std::string& at, double most = 1.0) {
     const auto it = v.find("strength");
     if (it == v.end()) return 1.0;
     const double s = r.positive(*it, at + "/strength");
-    if (s > 1.0) r.fail(at + "/strength", "expected a fraction, greater than 0 and at most 1");
+    if (s > most)
+        r.fail(at + "/strength", most == 1.0
+                                     ? "expected a fraction, greater than 0 and at most 1"
+                                     : "expected greater than 0 and at most " + formatNumber(most));
     return s;
 }
 
@@ -446,7 +449,7 @@ InflateStroke readInflate(const Reader& r, const json& v, const std::string& at)
 SmoothStroke readSmooth(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "smooth");
     SmoothStroke s;
-    s.strength = readStrength(r, v, at);
+    s.strength = readStrength(r, v, at, kMostSmoothStrength);
     s.radial = readRadial(r, v, at);
     s.tool = readTool(r, r.require(v, at, "tool"), at + "/tool", nullptr, 1);
     if (s.tool.shape != ToolShapeKind::Ball) r.fail(at + "/tool/shape", "smoothing takes a ball");

@@ -9,8 +9,10 @@
 #include "core/falloff.h"
 #include "core/format.h"
 #include "core/limits.h"
+#include "core/stopwatch.h"
 #include "levelset/dilate.h"
 #include "levelset/fast_marching.h"
+#include "levelset/padded_leaf.h"
 #include "levelset/parallel.h"
 
 namespace sweepers {
@@ -19,53 +21,10 @@ namespace {
 
 using Leaf = Grid::TreeType::LeafNodeType;
 
-// A leaf's values and the layer of voxels around it (10 x 10 x 10, x slowest): the
-// stencils of a step read this block instead of the tree. The 26 leaves around are found
-// once (their buffers, or the one value of a tile or of empty space) and read directly.
-struct PaddedLeaf {
-    std::array<float, 1000> v;
-    // (x, y, z) from -1 to 8 each.
-    static std::size_t index(int x, int y, int z) {
-        return std::size_t(x + 1) * 100 + std::size_t(y + 1) * 10 + std::size_t(z + 1);
-    }
-    float at(int x, int y, int z) const { return v[index(x, y, z)]; }
-
-    struct Around {
-        std::array<const float*, 27> buffer; // (dx + 1) * 9 + (dy + 1) * 3 + dz + 1
-        std::array<float, 27> value;         // where there is no leaf
-    };
-    static Around around(const Grid& grid, const Leaf& leaf) {
-        Around a;
-        const Grid::ConstAccessor acc = grid.getConstAccessor();
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz) {
-                    const std::size_t k =
-                        std::size_t(dx + 1) * 9 + std::size_t(dy + 1) * 3 + std::size_t(dz + 1);
-                    const openvdb::Coord o = leaf.origin().offsetBy(8 * dx, 8 * dy, 8 * dz);
-                    const Leaf* n = grid.tree().probeConstLeaf(o);
-                    a.buffer[k] = n ? n->buffer().data() : nullptr;
-                    a.value[k] = n ? 0.0f : acc.getValue(o);
-                }
-        return a;
-    }
-
-    void load(const Around& a) {
-        for (int x = -1; x <= 8; ++x) {
-            const int nx = x < 0 ? 0 : x > 7 ? 2 : 1, lx = (x + 8) & 7;
-            for (int y = -1; y <= 8; ++y) {
-                const int ny = y < 0 ? 0 : y > 7 ? 2 : 1, ly = (y + 8) & 7;
-                for (int z = -1; z <= 8; ++z) {
-                    const int nz = z < 0 ? 0 : z > 7 ? 2 : 1, lz = (z + 8) & 7;
-                    const std::size_t k =
-                        std::size_t(nx) * 9 + std::size_t(ny) * 3 + std::size_t(nz);
-                    const float* b = a.buffer[k];
-                    v[index(x, y, z)] = b ? b[lx * 64 + ly * 8 + lz] : a.value[k];
-                }
-            }
-        }
-    }
-};
+// The filter's multiply-adds that take as long as a voxel's explicit step (the curvature
+// term's differences, about 40 of them, read from a padded leaf): the filter's work is
+// counted in explicit updates, so that the two compare.
+constexpr double kOperationsPerUpdate = 70.0;
 
 // kappa |grad phi| by central differences at (x, y, z) of the block (the curvature term of
 // the level-set equation for mean-curvature flow), in world units:
@@ -90,8 +49,9 @@ double curvatureTerm(const PaddedLeaf& b, int x, int y, int z, double h) {
 
 } // namespace
 
-CurvatureSmoother::CurvatureSmoother(Grid& grid, const SmoothBrush& brush, Interrupter* interrupter)
-    : grid_(grid), brush_(brush), interrupter_(interrupter) {
+CurvatureSmoother::CurvatureSmoother(Grid& grid, const SmoothBrush& brush, Interrupter* interrupter,
+                                     const SmoothOptions& options)
+    : grid_(grid), brush_(brush), interrupter_(interrupter), options_(options) {
     const double h = grid.voxelSize()[0];
     const openvdb::Vec3d c =
         grid.worldToIndex({brush.center.x(), brush.center.y(), brush.center.z()});
@@ -106,99 +66,178 @@ double CurvatureSmoother::renormalizedRadius() const {
     return reachRadius() / grid_.voxelSize()[0] - 1.0;
 }
 
-SmoothStats CurvatureSmoother::run() {
+const SmoothStats& CurvatureSmoother::plan() {
+    if (planned_) return stats_;
+    planned_ = true;
+    const auto start = Clock::now();
     stats_ = SmoothStats();
     stats_.changed = reach_;
     if (!(brush_.time > 0.0) || !(brush_.radius > 0.0)) return stats_;
-    collectLeaves();
+    // The reach and the voxel the differences read beyond it; where the filter may run, the
+    // band it reads too, from which those within the reach are taken.
+    const double reach = reachRadius() / grid_.voxelSize()[0] + 2.0;
+    std::vector<Leaf*> around;
+    if (options_.scheme != SmoothScheme::ExplicitFlow &&
+        sigmaVoxels() >= DistanceFilter::kSmallestSigma) {
+        const openvdb::Vec3d c =
+            grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+        filter_ = std::make_unique<DistanceFilter>(grid_, sigmaVoxels(), openvdb::Coord::round(c));
+        // The splat's, blur's and slice's reach around the voxels that flow, in voxels.
+        const DistanceFilterStats& f = filter_->stats();
+        const int grow = (f.radius + 2) * f.spacing + 1;
+        around = leavesIn(
+            std::max(reach, (brush_.radius + brush_.falloff) / grid_.voxelSize()[0] + 1.0 + grow));
+        for (Leaf* leaf : around)
+            if (leafNear(leaf->origin(), reach)) leaves_.push_back(leaf);
+    } else {
+        leaves_ = leavesIn(reach);
+    }
+    stats_.leaves = leaves_.size();
     weigh();
-    requireAffordable();
-    widenBand();
-    pollInterrupt(interrupter_);
-    flow();
-    pollInterrupt(interrupter_);
-    renormalizeReach();
+    estimateWork(around);
+    const bool filter = stats_.filterWork > 0.0 && (options_.scheme == SmoothScheme::Filter ||
+                                                    stats_.filterWork < stats_.flowWork);
+    stats_.scheme = filter ? SmoothScheme::Filter : SmoothScheme::ExplicitFlow;
+    stats_.work = stats_.scheme == SmoothScheme::Filter ? stats_.filterWork : stats_.flowWork;
+    if (!filter) filter_.reset();
+    stats_.planSeconds = secondsSince(start);
     return stats_;
 }
 
-void CurvatureSmoother::collectLeaves() {
-    leaves_.clear();
-    // Leaf by leaf origin inside the reach: the work is the brush's, not the grid's. A
+SmoothStats CurvatureSmoother::run() {
+    plan();
+    if (!(brush_.time > 0.0) || !(brush_.radius > 0.0)) return stats_;
+    requireWork(stats_.work, workDescription());
+    pollInterrupt(interrupter_);
+    const auto update = Clock::now();
+    if (stats_.scheme == SmoothScheme::Filter) {
+        // The filter reads only the band as it is: the band grows afterwards, as far as the
+        // surface moved.
+        filter();
+        widenBand(int(std::ceil(stats_.mostChange / grid_.voxelSize()[0])));
+    } else {
+        widenBand(2);
+        flow();
+    }
+    pollInterrupt(interrupter_);
+    stats_.updateSeconds = secondsSince(update);
+    const auto renormalization = Clock::now();
+    renormalizeReach();
+    stats_.renormalizeSeconds = secondsSince(renormalization);
+    return stats_;
+}
+
+bool CurvatureSmoother::leafNear(const openvdb::Coord& origin, double radius) const {
+    const openvdb::Vec3d c =
+        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+    const openvdb::Vec3d lo = origin.asVec3d(), hi = lo + openvdb::Vec3d(Leaf::DIM - 1);
+    const openvdb::Vec3d nearest(std::clamp(c.x(), lo.x(), hi.x()),
+                                 std::clamp(c.y(), lo.y(), hi.y()),
+                                 std::clamp(c.z(), lo.z(), hi.z()));
+    return (nearest - c).lengthSqr() <= radius * radius;
+}
+
+std::vector<CurvatureSmoother::Leaf*> CurvatureSmoother::leavesIn(double radius) {
+    std::vector<Leaf*> leaves;
+    const openvdb::Vec3d c =
+        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+    const openvdb::CoordBBox box(openvdb::Coord::floor(c - openvdb::Vec3d(radius)),
+                                 openvdb::Coord::ceil(c + openvdb::Vec3d(radius)));
+    const auto near = [&](const openvdb::Coord& origin) { return leafNear(origin, radius); };
+    // Leaf by leaf origin inside the ball's box: the work is the brush's, not the grid's. A
     // brush larger than the shape would probe mostly empty space: then the grid's own
     // leaves are walked instead, so the work is the smaller of the two.
-    const openvdb::Coord lo = reach_.min() & ~(Leaf::DIM - 1), hi = reach_.max();
+    const openvdb::Coord lo = box.min() & ~(Leaf::DIM - 1), hi = box.max();
     const openvdb::Coord slots = ((hi - lo) >> Leaf::LOG2DIM) + openvdb::Coord(1);
     const double probes = double(slots.x()) * slots.y() * slots.z();
     if (probes > double(grid_.tree().leafCount())) {
         for (auto it = grid_.tree().beginLeaf(); it; ++it) {
             ++stats_.leavesVisited;
-            if (reach_.hasOverlap(it->getNodeBoundingBox())) leaves_.push_back(&*it);
+            if (near(it->origin())) leaves.push_back(&*it);
         }
     } else {
-        for (int x = lo.x(); x <= hi.x(); x += Leaf::DIM)
-            for (int y = lo.y(); y <= hi.y(); y += Leaf::DIM)
-                for (int z = lo.z(); z <= hi.z(); z += Leaf::DIM) {
-                    ++stats_.leavesVisited;
-                    if (Leaf* leaf = grid_.tree().probeLeaf({x, y, z})) leaves_.push_back(leaf);
-                }
+        // Slab by slab along x in parallel, put together in order.
+        std::vector<std::vector<Leaf*>> slab(std::size_t(slots.x()));
+        std::vector<std::size_t> visited(std::size_t(slots.x()), 0);
+        parallelFor(tbb::blocked_range<std::size_t>(0, slab.size()), [&](const auto& range) {
+            for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                const int x = lo.x() + int(k) * int(Leaf::DIM);
+                for (int y = lo.y(); y <= hi.y(); y += Leaf::DIM)
+                    for (int z = lo.z(); z <= hi.z(); z += Leaf::DIM) {
+                        if (!near({x, y, z})) continue;
+                        ++visited[k];
+                        if (Leaf* leaf = grid_.tree().probeLeaf({x, y, z})) slab[k].push_back(leaf);
+                    }
+            }
+        });
+        for (std::size_t k = 0; k < slab.size(); ++k) {
+            stats_.leavesVisited += visited[k];
+            leaves.insert(leaves.end(), slab[k].begin(), slab[k].end());
+        }
     }
-    stats_.leaves = leaves_.size();
+    return leaves;
 }
 
 void CurvatureSmoother::weigh() {
-    const double r = brush_.radius, f = brush_.falloff;
+    const double r = brush_.radius, f = brush_.falloff, h = grid_.voxelSize()[0];
     const float bg = grid_.background();
+    // Distances in index space times h (the grid's map is a uniform scale, turned and
+    // moved).
+    const openvdb::Vec3d c =
+        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
     // Band voxels within the falloff's reach (not those at +-background: they hold no
-    // distance).
-    std::vector<std::array<float, Leaf::SIZE>> weight(leaves_.size());
-    std::vector<char> reached(leaves_.size(), 0);
+    // distance). Leaves wholly beyond it are passed over.
+    weight_.resize(leaves_.size());
+    std::vector<leafwords::Words> words(leaves_.size());
+    const double reached = (r + f) / h + 1.0;
     parallelFor(tbb::blocked_range<std::size_t>(0, leaves_.size()), [&](const auto& range) {
         for (std::size_t l = range.begin(); l != range.end(); ++l) {
             const Leaf& leaf = *leaves_[l];
+            words[l].fill(0);
+            if (!leafNear(leaf.origin(), reached)) continue;
             for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
-                weight[l][i] = 0.0f;
+                weight_[l][i] = 0.0f;
                 if (!leaf.isValueOn(i) || std::abs(leaf.getValue(i)) >= bg) continue;
-                const openvdb::Vec3d w = grid_.indexToWorld(leaf.offsetToGlobalCoord(i));
-                const double d = (Eigen::Vector3d(w.x(), w.y(), w.z()) - brush_.center).norm() - r;
-                weight[l][i] = float(falloffMu(d, f));
-                reached[l] |= weight[l][i] > 0.0f;
+                const double d = (leaf.offsetToGlobalCoord(i).asVec3d() - c).length() * h - r;
+                weight_[l][i] = float(falloffMu(d, f));
+                if (weight_[l][i] > 0.0f) words[l][i >> 6] |= leafwords::Word(1) << (i & 63);
             }
         }
     });
     flowing_.clear();
-    weight_.clear();
     weighted_.clear();
     for (std::size_t l = 0; l < leaves_.size(); ++l) {
-        if (!reached[l]) continue;
+        if (!leafwords::any(words[l])) continue;
         flowing_.push_back(l);
-        weight_.push_back(weight[l]);
-        LeafVoxels lv{leaves_[l]->origin(), {}};
-        for (openvdb::Index i = 0; i < Leaf::SIZE; ++i)
-            if (weight[l][i] > 0.0f) lv.words[i >> 6] |= leafwords::Word(1) << (i & 63);
-        weighted_.push_back(lv);
+        weighted_.push_back({leaves_[l]->origin(), words[l]});
     }
 }
 
-// A dab may move the surface by two voxels: the band grows by two voxels around the voxels
-// that flow (within the renormalized ball), so that the renormalization finds band on
+// A dab may move the surface by two voxels: the band grows by as many voxels around the
+// voxels that flow (within the renormalized ball), so that the renormalization finds band on
 // whichever side the surface moved to. The new voxels keep the value they held
 // (+-background, of the right sign) and take no part in the flow; the renormalization gives
 // them distances, or drops them past the half-width.
-void CurvatureSmoother::widenBand() {
+void CurvatureSmoother::widenBand(int layers) {
+    if (layers <= 0) return;
     const openvdb::Vec3d c =
         grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
     const double r = renormalizedRadius();
-    for (const LeafVoxels& lv : dilatedByCube(weighted_, 2)) {
+    for (const LeafVoxels& lv : dilatedByCube(weighted_, layers)) {
         Leaf* leaf = grid_.tree().probeLeaf(lv.origin);
         const bool made = !leaf;
+        LeafVoxels fresh{lv.origin, {}};
         for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
             if (!((lv.words[i >> 6] >> (i & 63)) & 1)) continue;
             if (((lv.origin + Leaf::offsetToLocalCoord(i)).asVec3d() - c).lengthSqr() > r * r)
                 continue;
             if (!leaf) leaf = grid_.tree().touchLeaf(lv.origin);
+            if (leaf->isValueOn(i)) continue;
             leaf->setValueOn(i);
+            fresh.words[i >> 6] |= leafwords::Word(1) << (i & 63);
         }
         if (made && leaf) leaves_.push_back(leaf); // renormalized with the others
+        if (leafwords::any(fresh.words)) fresh_.push_back(fresh);
     }
 }
 
@@ -211,16 +250,35 @@ double CurvatureSmoother::stepCount() const {
     return std::max(1.0, std::ceil(brush_.time / dtMax));
 }
 
-// Before the grid changes: the flow's steps times the voxels that flow, against the work
-// limit (a ball far larger than the shape, or far finer a grid, would flow for hours).
-void CurvatureSmoother::requireAffordable() const {
+double CurvatureSmoother::sigmaVoxels() const {
+    return std::sqrt(2.0 * brush_.time) / grid_.voxelSize()[0];
+}
+
+// The dab's work, checked against the work limit before the grid changes (a ball far larger
+// than the shape, or far finer a grid, would run for hours), counted in voxel updates of the
+// explicit flow: its steps times the voxels that flow. The filter's splat, blur and
+// read-back count kOperationsPerUpdate multiply-adds an update. A dab runs the scheme that
+// takes less.
+void CurvatureSmoother::estimateWork(const std::vector<Leaf*>& around) {
     double voxels = 0.0;
     for (const LeafVoxels& lv : weighted_)
         for (const leafwords::Word w : lv.words)
             voxels += double(__builtin_popcountll(w));
-    requireWork(stepCount() * voxels, "a smooth dab of radius " + formatNumber(brush_.radius) +
-                                          " (" + formatNumber(stepCount()) + " steps of " +
-                                          formatNumber(voxels) + " voxels)");
+    stats_.weighted = std::size_t(voxels);
+    stats_.flowWork = stepCount() * voxels;
+    if (filter_) {
+        filter_->plan(std::vector<const Leaf*>(around.begin(), around.end()), weighted_);
+        stats_.latticeSpacing = filter_->stats().spacing;
+        stats_.filterWork = (filter_->stats().work + 64.0 * voxels) / kOperationsPerUpdate;
+    }
+}
+
+std::string CurvatureSmoother::workDescription() const {
+    const std::string dab = "a smooth dab of radius " + formatNumber(brush_.radius);
+    if (stats_.scheme == SmoothScheme::Filter)
+        return dab + " (a filter over " + formatNumber(double(stats_.weighted)) + " voxels)";
+    return dab + " (" + formatNumber(stepCount()) + " steps of " +
+           formatNumber(double(stats_.weighted)) + " voxels)";
 }
 
 void CurvatureSmoother::flow() {
@@ -252,8 +310,9 @@ void CurvatureSmoother::flow() {
                     const int x = int(i >> 6), y = int((i >> 3) & 7), z = int(i & 7);
                     const float p = block.at(x, y, z);
                     next[k][i] = p;
-                    if (weight_[k][i] == 0.0f) continue;
-                    const double moved = p + dt * weight_[k][i] * curvatureTerm(block, x, y, z, h);
+                    if (weight_[flowing_[k]][i] == 0.0f) continue;
+                    const double moved =
+                        p + dt * weight_[flowing_[k]][i] * curvatureTerm(block, x, y, z, h);
                     next[k][i] = std::clamp(float(moved), start[k][i] - most, start[k][i] + most);
                     ++n;
                 }
@@ -269,26 +328,114 @@ void CurvatureSmoother::flow() {
     stats_.updates = updates.combine(std::plus<>());
 }
 
+void CurvatureSmoother::filter() {
+    const double h = grid_.voxelSize()[0];
+    filter_->splat();
+    pollInterrupt(interrupter_);
+    filter_->blur();
+    pollInterrupt(interrupter_);
+    // Each voxel under the brush goes w of the way to the filtered distance (at most two
+    // voxels); all are computed from the values before the dab, then written.
+    const float most = float(2.0 * h), toVoxels = float(1.0 / h);
+    // The voxels next to the surface, whose changes bound its motion. A change of less than
+    // a hundredth of a voxel is a nudge, left out as advection leaves it out (levelset/
+    // advect.h): the values stay distances, and seeding again next to nudges alone would
+    // let the surface creep.
+    const float bg = grid_.background(), shell = float(1.5 * h), nudge = float(0.01 * h);
+    changed_.resize(flowing_.size());
+    for (std::size_t k = 0; k < flowing_.size(); ++k)
+        changed_[k] = {leaves_[flowing_[k]]->origin(), {}};
+    std::vector<std::array<float, Leaf::SIZE>> next(flowing_.size());
+    tbb::enumerable_thread_specific<std::size_t> updates(0);
+    tbb::enumerable_thread_specific<float> changes(0.0f);
+    parallelFor(tbb::blocked_range<std::size_t>(0, flowing_.size()), [&](const auto& range) {
+        float& changeMost = changes.local();
+        PaddedLeaf block;
+        std::array<openvdb::Vec3f, Leaf::SIZE> gradient;
+        std::array<float, Leaf::SIZE> u;
+        std::size_t n = 0;
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            const Leaf& leaf = *leaves_[flowing_[k]];
+            block.load(PaddedLeaf::around(grid_, leaf));
+            for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
+                if (weight_[flowing_[k]][i] == 0.0f) continue;
+                const int x = int(i >> 6), y = int((i >> 3) & 7), z = int(i & 7);
+                // Central differences, or one-sided ones where a neighbour lies past the band
+                // (its value is the background, no distance).
+                const float p = block.at(x, y, z);
+                const auto slope = [&](float below, float above) {
+                    const bool b = std::abs(below) < bg, a = std::abs(above) < bg;
+                    return a && b ? 0.5f * (above - below) : a ? above - p : b ? p - below : 0.0f;
+                };
+                gradient[i] = openvdb::Vec3f(slope(block.at(x - 1, y, z), block.at(x + 1, y, z)),
+                                             slope(block.at(x, y - 1, z), block.at(x, y + 1, z)),
+                                             slope(block.at(x, y, z - 1), block.at(x, y, z + 1))) *
+                              toVoxels;
+            }
+            filter_->read(leaf.origin(), weighted_[k].words, gradient, u);
+            const float* values = leaf.buffer().data();
+            for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
+                const float p = values[i];
+                next[k][i] = p;
+                if (weight_[flowing_[k]][i] == 0.0f || !std::isfinite(u[i])) continue;
+                const float moved = std::clamp(p + weight_[flowing_[k]][i] * (u[i] * float(h) - p),
+                                               p - most, p + most);
+                if (!(std::abs(moved - p) >= nudge)) continue;
+                next[k][i] = moved;
+                changed_[k].words[i >> 6] |= leafwords::Word(1) << (i & 63);
+                if (std::abs(p) < shell)
+                    changeMost = std::max(changeMost, std::abs(next[k][i] - p));
+                ++n;
+            }
+        }
+        updates.local() += n;
+    });
+    parallelFor(tbb::blocked_range<std::size_t>(0, flowing_.size()), [&](const auto& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+            std::copy(next[k].begin(), next[k].end(), leaves_[flowing_[k]]->buffer().data());
+    });
+    stats_.updates = updates.combine(std::plus<>());
+    stats_.mostChange = changes.combine([](float a, float b) { return std::max(a, b); });
+}
+
 void CurvatureSmoother::renormalizeReach() {
     // The voxels within the reach less a voxel: beyond them every value stays as it was (the
     // box's corners too) but for an inactive voxel next to them that the band takes in.
     const openvdb::Vec3d c =
         grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
     const double r = renormalizedRadius();
+    const auto clip = [&](LeafVoxels& lv) {
+        for (openvdb::Index i = 0; i < Leaf::SIZE; ++i)
+            if (((lv.origin + Leaf::offsetToLocalCoord(i)).asVec3d() - c).lengthSqr() > r * r)
+                lv.words[i >> 6] &= ~(leafwords::Word(1) << (i & 63));
+    };
+    if (stats_.scheme == SmoothScheme::Filter) {
+        // Where values changed, and as far as the band reaches from there, as after a
+        // segment; seeds again only next to what moved.
+        VoxelList freed =
+            dilatedByCube(changed_, int(std::ceil(grid_.background() / grid_.voxelSize()[0])) + 1);
+        for (LeafVoxels& lv : freed)
+            clip(lv);
+        VoxelList moved = changed_;
+        freed.insert(freed.end(), fresh_.begin(), fresh_.end());
+        moved.insert(moved.end(), fresh_.begin(), fresh_.end());
+        renormalize(grid_, reach_, freed, moved, FmmOrder::Second, interrupter_);
+        return;
+    }
     VoxelList inside;
     inside.reserve(leaves_.size());
     for (const Leaf* leaf : leaves_) {
         LeafVoxels lv{leaf->origin(), {}};
-        for (openvdb::Index i = 0; i < Leaf::SIZE; ++i)
-            if ((leaf->offsetToGlobalCoord(i).asVec3d() - c).lengthSqr() <= r * r)
-                lv.words[i >> 6] |= leafwords::Word(1) << (i & 63);
+        lv.words.fill(~leafwords::Word(0));
+        clip(lv);
         if (leafwords::any(lv.words)) inside.push_back(lv);
     }
     renormalize(grid_, reach_, inside, FmmOrder::Second, interrupter_);
 }
 
-SmoothStats smoothLevelSet(Grid& grid, const SmoothBrush& brush, Interrupter* interrupter) {
-    return CurvatureSmoother(grid, brush, interrupter).run();
+SmoothStats smoothLevelSet(Grid& grid, const SmoothBrush& brush, Interrupter* interrupter,
+                           const SmoothOptions& options) {
+    return CurvatureSmoother(grid, brush, interrupter, options).run();
 }
 
 } // namespace sweepers

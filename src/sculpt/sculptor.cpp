@@ -56,11 +56,12 @@ SegmentReport Sculptor::applySegment(const StepDeformation& deformation) {
 }
 
 SegmentReport Sculptor::applySmoothDab(const SmoothBrush& brush) {
-    CurvatureSmoother smoother(*grid_, brush, options_.interrupter);
+    CurvatureSmoother smoother(*grid_, brush, options_.interrupter, smoothOptions_);
     if (recording_) record_.capture(*grid_, smoother.reach());
     SegmentReport r;
     const SerialClock dab;
     const SmoothStats s = smoother.run();
+    r.smooth = s;
     r.seconds = r.otherSeconds = dab.wallSeconds();
     r.otherSerialSeconds = dab.serialSeconds();
     if (meshing_) {

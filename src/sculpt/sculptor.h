@@ -44,6 +44,7 @@ struct SegmentReport {
         }
         return serial + std::max(0.0, seconds - phases);
     }
+    SmoothStats smooth; // of a smooth dab (scheme, voxels under the brush, work)
     std::size_t remeshedLeaves = 0;
     double meshVolume = 0.0; // enclosed volume of the mesh after the segment (applyStrokes,
                              // when meshing: it sums the whole mesh)
@@ -68,6 +69,9 @@ class Sculptor {
     // (or drop the grid).
     void setInterrupter(Interrupter* interrupter);
     Interrupter* interrupter() const { return options_.interrupter; }
+
+    // How smooth dabs run (the reference explicit flow, for comparisons).
+    void setSmoothOptions(const SmoothOptions& options) { smoothOptions_ = options; }
 
     // Keeps a marching-cubes mesh up to date after every segment (built now, whole).
     void startMeshing();
@@ -99,6 +103,7 @@ class Sculptor {
   private:
     GridPtr grid_;
     AdvectOptions options_;
+    SmoothOptions smoothOptions_;
     SegmentAdvector advector_; // one for every segment: its scratch is kept between them
     SurfaceMesher mesher_;
     bool meshing_ = false, recording_ = false;

@@ -163,14 +163,18 @@ struct FluidStroke {
     std::shared_ptr<const SweptFluid> fluid;
 };
 
+// A smooth dab's strength may reach past 1 (a flow time longer than the default dab's):
+// up to this.
+inline constexpr double kMostSmoothStrength = 10.0;
+
 // Smoothing under a ball: one dab at each placement of the tool's path (its translation; the
 // radius and falloff are the tool's), each a mean-curvature flow (levelset/smooth.h) lasting
 // strength x kSmoothTimePerRadius2 x radius^2. The velocity is the surface's own curvature,
 // so each dab runs on the grid the one before left: planStroke makes no deformation of it
 // (Sculptor::applyStroke runs the dabs), and a history holding one has no exact reference.
 struct SmoothStroke {
-    ToolSpec tool; // a ball
-    double strength = 1.0;
+    ToolSpec tool;           // a ball
+    double strength = 1.0;   // (0, kMostSmoothStrength]
     RadialSymmetry radial{}; // each dab's copies follow it
 };
 

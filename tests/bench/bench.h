@@ -62,6 +62,7 @@ void registerAdvectBenchmarks();
 void registerRenormalizeBenchmarks();
 void registerMeshBenchmarks();
 void registerEnrightBenchmarks();
+void registerBrushBenchmarks();
 
 // The benchmark name is "group/case/method"; times are wall-clock milliseconds.
 benchmark::internal::Benchmark* add(const std::string& name,

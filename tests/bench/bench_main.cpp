@@ -262,6 +262,7 @@ int main(int argc, char** argv) {
     registerRenormalizeBenchmarks();
     registerMeshBenchmarks();
     registerEnrightBenchmarks();
+    registerBrushBenchmarks();
 
     Collector collector;
     benchmark::RunSpecifiedBenchmarks(&collector);

@@ -123,7 +123,19 @@ printf '{"sweepers": 1, "grid": {"voxel_size": 0.0625}, "strokes": [{"type": "fl
 small "flow steps; at most 1e6" apply far_fluid.json -o out.vdb
 small "fluid segment 1 of radius 0.3 takes about" --max-work 1e5 apply "$data/fluid/nose_fluid.json" -o out.vdb
 printf '{"sweepers": 1, "grid": {"voxel_size": 0.0625}, "strokes": [{"type": "smooth", "tool": {"shape": "ball", "size": 1e4, "falloff": 0.1, "path": [{"t": [0, 1, 0]}]}}]}' >huge_smooth.json
-small "a smooth dab of radius 10000" apply huge_smooth.json -o out.vdb
+# A smooth dab far larger than the shape is a filter of a few lattice nodes now: it runs at
+# once, and moves the surface no more than two voxels. Past the work limit it is refused.
+timeout 20 /usr/bin/time -f %M -o peak "$cli" -q apply huge_smooth.json -o huge_smooth.vdb ||
+  fail "a smooth dab of radius 1e4 did not run"
+[ "$(tail -1 peak)" -lt 300000 ] || fail "a smooth dab of radius 1e4 peaked at $(tail -1 peak) KB"
+"$cli" info --json huge_smooth.vdb | "$py" -c '
+import json, sys
+info = json.load(sys.stdin)
+radius = (info["mesh_volume"] * 3 / (4 * 3.14159265)) ** (1 / 3)
+assert info["components"] == 1 and 1 - 2.5 * 0.0625 < radius < 1, info
+print(f"a smooth dab of radius 1e4 on the unit sphere: its radius is now {radius:.3f}")'
+printf '{"sweepers": 1, "grid": {"voxel_size": 0.0625}, "strokes": [{"type": "smooth", "tool": {"shape": "ball", "size": 0.5, "falloff": 0.1, "path": [{"t": [0, 1, 0]}]}}]}' >smooth.json
+small "a smooth dab of radius 0.5" --max-work 100 apply smooth.json -o out.vdb
 small "applying the script needs about" apply "$data/studies/rigid_motion.json" -o out.vdb --voxel-size 0.000244140625
 small "needs about" study "$data/studies/rigid_motion.json" -o big_study --voxel-sizes 1/4096
 small "over its limit of 1 MB (--max-memory)" apply "$data/studies/rigid_motion.json" -o out.vdb --max-memory 0.001

@@ -5,14 +5,20 @@
 
 #include <cmath>
 
-#include <openvdb/math/Stencils.h>
-#include <openvdb/tools/LevelSetRebuild.h>
+#include <atomic>
 
+#include <openvdb/math/Stencils.h>
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/LevelSetRebuild.h>
+#include <tbb/global_control.h>
+
+#include "coarse.h"
 #include "core/limits.h"
 #include "grids.h"
 #include "io/stroke_script.h"
 #include "io/study_files.h"
 #include "levelset/band.h"
+#include "levelset/create.h"
 #include "levelset/fast_marching.h"
 #include "levelset/measure.h"
 #include "levelset/smooth.h"
@@ -129,7 +135,7 @@ TEST(Smooth, StrengthIsAFractionOfTheFlowTime) {
 TEST(Smooth, TheWrittenStrokeReplaysToTheSameGrid) {
     const GridPtr start = bumpySphere();
     const SmoothStroke stroke =
-        dabsAt({{0.0, kR, 0.0}, {0.1, kR - 0.01, 0.0}, {0.2, kR - 0.04, 0.05}}, 0.7);
+        dabsAt({{0.0, kR, 0.0}, {0.1, kR - 0.01, 0.0}, {0.2, kR - 0.04, 0.05}}, 4.0);
     Sculptor a(start->deepCopy());
     a.applyStroke(stroke);
 
@@ -141,7 +147,7 @@ TEST(Smooth, TheWrittenStrokeReplaysToTheSameGrid) {
     const auto* read = std::get_if<SmoothStroke>(&back.strokes[0]);
     ASSERT_NE(read, nullptr);
     EXPECT_EQ(read->tool.path.size(), 3u);
-    EXPECT_EQ(read->strength, 0.7);
+    EXPECT_EQ(read->strength, 4.0); // past 1: a smooth stroke's strength reaches 10
     Sculptor b(start->deepCopy());
     b.applyStroke(back.strokes[0]);
     EXPECT_EQ(differingVoxels(a.grid(), b.grid()), 0u);
@@ -225,14 +231,15 @@ TEST(Smooth, ADabBeyondTheWorkLimitIsRefusedBeforeTheGridChanges) {
     brush.radius = kBrush;
     brush.falloff = kFall;
     brush.time = kSmoothTimePerRadius2 * kBrush * kBrush;
-    // What the dab takes: its steps times the voxels under the ball.
-    const SmoothStats s = smoothLevelSet(*g->deepCopy(), brush);
-    ASSERT_GT(s.updates, 1000u);
+    // What the dab takes, as planned: the grid does not change.
+    const SmoothStats s = CurvatureSmoother(*g, brush).plan();
+    EXPECT_EQ(test::differingBits(*g, *before), 0u);
+    ASSERT_GT(s.work, 1000.0);
     {
-        const ScopedLimits tight({0.0, double(s.updates) / 2});
+        const ScopedLimits tight({0.0, s.work / 2});
         try {
             smoothLevelSet(*g, brush);
-            ADD_FAILURE() << "a dab of " << s.updates << " updates passed a limit of half that";
+            ADD_FAILURE() << "a dab of " << s.work << " updates passed a limit of half that";
         } catch (const LimitExceeded& e) {
             EXPECT_NE(std::string(e.what()).find("more than the limit of"), std::string::npos)
                 << e.what();
@@ -240,7 +247,235 @@ TEST(Smooth, ADabBeyondTheWorkLimitIsRefusedBeforeTheGridChanges) {
         EXPECT_EQ(test::differingBits(*g, *before), 0u);
         EXPECT_EQ(g->tree().leafCount(), before->tree().leafCount());
     }
-    // Within the limit (the estimate counts the voxels the flow updates), it runs.
-    const ScopedLimits enough({0.0, double(s.updates) * 1.01});
-    EXPECT_EQ(smoothLevelSet(*g, brush).updates, s.updates);
+    // Within the limit, it runs, and its work was the one planned.
+    const ScopedLimits enough({0.0, s.work * 1.01});
+    const SmoothStats ran = smoothLevelSet(*g, brush);
+    EXPECT_EQ(ran.work, s.work);
+    EXPECT_GT(ran.updates, 1000u);
+}
+
+namespace {
+
+// A sphere of radius 0.5 with ridges a sin(k x) (wavelength l) across its top, renormalized.
+GridPtr ridgedSphere(double h, double l, double amplitude) {
+    GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 0.5, h, 3.0);
+    const double k = 2.0 * M_PI / l;
+    const float bg = g->background();
+    for (auto it = g->beginValueOn(); it; ++it) {
+        const Eigen::Vector3d p = toEigen(g->indexToWorld(it.getCoord()));
+        const double d = p.norm() - 0.5 - amplitude * std::sin(k * p.x());
+        it.setValue(float(std::clamp(d, -double(bg), double(bg))));
+    }
+    renormalizeAll(*g);
+    return g;
+}
+
+// The distance from the centre of the surface of a sphere of radius about 0.5, along the ray
+// through (x, y, z) on it (y > 0): bisection of the trilinear field.
+double surfaceRadius(const Grid& g, double x, double z) {
+    const double h = g.voxelSize()[0];
+    const Eigen::Vector3d dir = Eigen::Vector3d(x, std::sqrt(0.25 - x * x - z * z), z) / 0.5;
+    double in = 0.5 - 4.0 * h, out = 0.5 + 4.0 * h;
+    for (int it = 0; it < 40; ++it) {
+        const double mid = 0.5 * (in + out);
+        const Eigen::Vector3d p = mid * dir;
+        (openvdb::tools::BoxSampler::sample(g.tree(), g.worldToIndex(toVdb(p))) < 0.0f ? in : out) =
+            mid;
+    }
+    return 0.5 * (in + out);
+}
+
+// The ridges' amplitude on the grid: the surface's radius along rays in the planes z = 0 and
+// z = +-l / 2 across |x| < half, projected on sin(k x) (the sphere's own shape, even in x,
+// drops out).
+double ridgeAmplitude(const Grid& g, double l, double half) {
+    const double k = 2.0 * M_PI / l;
+    double num = 0.0, den = 0.0;
+    const int n = 400;
+    for (const double z : {-0.5 * l, 0.0, 0.5 * l})
+        for (int j = 0; j <= n; ++j) {
+            const double x = -half + 2.0 * half * j / n, s = std::sin(k * x);
+            num += surfaceRadius(g, x, z) * s;
+            den += s * s;
+        }
+    return num / den;
+}
+
+// The ridges' amplitude before and after a dab whose time fades ridges of wavenumber k by
+// exp(-k^2 t) = 1 / e under the ball (weight 1): the measured exponent, -log(after/before).
+double ridgeExponent(const Grid& start, double l, double r, SmoothStats* stats = nullptr,
+                     const SmoothOptions& options = {}) {
+    const double k = 2.0 * M_PI / l;
+    // Whole wavelengths within 0.8 r of the centre (weight 1), and a quarter more.
+    const double half = std::floor(0.8 * r / l) * l / 2 + 0.25 * l;
+    const double before = ridgeAmplitude(start, l, half);
+    const GridPtr g = start.deepCopy();
+    SmoothBrush brush;
+    brush.center = Eigen::Vector3d(0.0, 0.5, 0.0);
+    brush.radius = r;
+    brush.falloff = 0.5 * r;
+    brush.time = 1.0 / (k * k);
+    const SmoothStats s = smoothLevelSet(*g, brush, nullptr, options);
+    if (stats) *stats = s;
+    return -std::log(ridgeAmplitude(*g, l, half) / before);
+}
+
+} // namespace
+
+TEST(Smooth, RidgesFadeAsTheLawSays) {
+    // Ridges from 4 voxels long to the ball's radius, each dab's time set so that the law
+    // gives an exponent of 1: the measured exponent is within a tenth of it, whichever
+    // scheme the dab runs (the filter from 8 voxels on; the flow at 4, whose dab is shorter
+    // than the filter's narrowest Gaussian).
+    const double r = 0.125;
+    std::vector<double> sizes{1.0 / 64, 1.0 / 128, 1.0 / 256};
+    if (test::coarse()) sizes.pop_back();
+    for (const double h : sizes) {
+        for (const double l : {4 * h, 8 * h, 16 * h, r}) {
+            if (l > r || (l == r && r <= 16 * h)) continue; // beyond the ball, or run already
+            const double amplitude = std::min(0.1 * h * (l / (4 * h)), 0.25 * h);
+            const GridPtr start = ridgedSphere(h, l, amplitude);
+            SmoothStats s;
+            SmoothOptions filter;
+            filter.scheme = SmoothScheme::Filter;
+            const double exponent = ridgeExponent(*start, l, r, &s, filter);
+            std::printf("[ smooth ] 1/%g, ridges %g voxels long: exponent %.3f (%s)\n", 1 / h,
+                        l / h, exponent,
+                        s.scheme == SmoothScheme::Filter ? "filter" : "explicit flow");
+            EXPECT_NEAR(exponent, 1.0, 0.1) << "1/" << 1 / h << ", " << l / h << " voxels";
+            EXPECT_EQ(s.scheme == SmoothScheme::Filter, l >= 8 * h) << 1 / h << ", " << l / h;
+        }
+    }
+}
+
+TEST(Smooth, TheFilterMovesTheFormAsTheFlowDoes) {
+    // A ridge as long as the ball is wide (the form at the brush's scale, a voxel high) under
+    // a dab of strength 2: the surface the filter leaves lies within a tenth of a voxel of
+    // the one the explicit flow leaves, across the ball and its falloff.
+    const double r = 0.125;
+    std::vector<double> sizes{1.0 / 128, 1.0 / 256};
+    if (test::coarse()) sizes.pop_back();
+    for (const double h : sizes) {
+        const GridPtr start = ridgedSphere(h, 2 * r, h);
+        SmoothBrush brush;
+        brush.center = Eigen::Vector3d(0.0, 0.5, 0.0);
+        brush.radius = r;
+        brush.falloff = r;
+        brush.time = 2.0 * kSmoothTimePerRadius2 * r * r;
+        const GridPtr filtered = start->deepCopy(), flowed = start->deepCopy();
+        SmoothOptions flow;
+        flow.scheme = SmoothScheme::ExplicitFlow;
+        SmoothOptions filter;
+        filter.scheme = SmoothScheme::Filter;
+        ASSERT_EQ(smoothLevelSet(*filtered, brush, nullptr, filter).scheme, SmoothScheme::Filter);
+        smoothLevelSet(*flowed, brush, nullptr, flow);
+        double differs = 0.0, moved = 0.0;
+        for (const double z : {-0.5 * r, 0.0, 0.5 * r})
+            for (int j = -40; j <= 40; ++j) {
+                const double x = 2.0 * r * j / 40.0;
+                const double a = surfaceRadius(*filtered, x, z), b = surfaceRadius(*flowed, x, z);
+                differs = std::max(differs, std::abs(a - b));
+                moved = std::max(moved, std::abs(b - surfaceRadius(*start, x, z)));
+            }
+        std::printf("[ smooth ] 1/%g: the flow moves the form by up to %.3f voxel, the filter "
+                    "differs from it by %.3f\n",
+                    1 / h, moved / h, differs / h);
+        EXPECT_GT(moved, 0.1 * h);
+        EXPECT_LT(differs, 0.1 * h) << "1/" << 1 / h;
+    }
+}
+
+TEST(Smooth, TheFilterGivesTheSameGridOnAnyThreadCount) {
+    const GridPtr start = bumpySphere();
+    SmoothBrush brush;
+    brush.center = Eigen::Vector3d(0.0, kR, 0.0);
+    brush.radius = kBrush;
+    brush.falloff = kFall;
+    brush.time = kSmoothTimePerRadius2 * kBrush * kBrush;
+    std::vector<GridPtr> grids;
+    for (const int threads : {1, 3}) {
+        const tbb::global_control c(tbb::global_control::max_allowed_parallelism,
+                                    std::size_t(threads));
+        grids.push_back(start->deepCopy());
+        SmoothOptions filter;
+        filter.scheme = SmoothScheme::Filter;
+        EXPECT_EQ(smoothLevelSet(*grids.back(), brush, nullptr, filter).scheme,
+                  SmoothScheme::Filter);
+    }
+    EXPECT_EQ(test::differingBits(*grids[0], *grids[1]), 0u);
+    EXPECT_GT(test::differingBits(*grids[0], *start), 0u);
+}
+
+TEST(Smooth, TheFilterWorkFollowsTheBandUnderTheBrush) {
+    // The same dab (strength 10) on the same sphere at r/h = 8, 16 and 32: the filter's work
+    // per voxel under the brush stays flat, where the explicit flow's grows as (r/h)^2. The
+    // work is counted as planned; the grids do not change.
+    const double r = 0.125;
+    std::vector<double> filterPerVoxel, flowPerVoxel;
+    for (const double h : {1.0 / 64, 1.0 / 128, 1.0 / 256}) {
+        const GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 0.5, h, 3.0);
+        SmoothBrush brush;
+        brush.center = Eigen::Vector3d(0.0, 0.5, 0.0);
+        brush.radius = r;
+        brush.falloff = r;
+        brush.time = 10.0 * kSmoothTimePerRadius2 * r * r;
+        const SmoothStats s = CurvatureSmoother(*g, brush).plan();
+        ASSERT_GT(s.filterWork, 0.0);
+        filterPerVoxel.push_back(s.filterWork / double(s.weighted));
+        flowPerVoxel.push_back(s.flowWork / double(s.weighted));
+        std::printf("[ smooth ] r/h %g: %zu voxels under the brush; updates a voxel: filter "
+                    "%.1f (lattice of %d voxels), explicit flow %.0f\n",
+                    r / h, s.weighted, filterPerVoxel.back(), s.latticeSpacing,
+                    flowPerVoxel.back());
+    }
+    EXPECT_LT(filterPerVoxel.back(), 1.25 * filterPerVoxel.front());
+    EXPECT_GT(flowPerVoxel.back(), 8.0 * flowPerVoxel.front());
+    // Where the flow takes less (the coarsest), it is what the dab runs.
+    EXPECT_LT(flowPerVoxel.front(), filterPerVoxel.front());
+    // At the finest, a dab of the filter runs and updates no more voxels than it weighs.
+    const GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 0.5, 1.0 / 256, 3.0);
+    SmoothBrush brush;
+    brush.center = Eigen::Vector3d(0.0, 0.5, 0.0);
+    brush.radius = r;
+    brush.falloff = r;
+    brush.time = 10.0 * kSmoothTimePerRadius2 * r * r;
+    const SmoothStats s = smoothLevelSet(*g, brush);
+    EXPECT_EQ(s.scheme, SmoothScheme::Filter);
+    EXPECT_LE(s.updates, s.weighted);
+    EXPECT_GT(s.updates, s.weighted / 2);
+}
+
+TEST(Smooth, ACancelledDabLeavesTheDocumentAsItWas) {
+    // An interrupter that stops at its n-th poll: whichever phase of the dab it stops, the
+    // recording puts the grid back bit for bit.
+    class StopAt : public Interrupter {
+      public:
+        explicit StopAt(int n) : left_(n) {}
+        bool wasInterrupted(int = -1) override { return --left_ < 0; }
+
+      private:
+        std::atomic<int> left_;
+    };
+    const GridPtr start = bumpySphere();
+    int stopped = 0;
+    for (int n = 0; n < 12; ++n) {
+        Sculptor sculptor(start->deepCopy());
+        SmoothOptions filter;
+        filter.scheme = SmoothScheme::Filter;
+        sculptor.setSmoothOptions(filter);
+        StopAt stop(n);
+        sculptor.setInterrupter(&stop);
+        sculptor.startRecording();
+        bool cancelled = false;
+        try {
+            sculptor.applyStroke(dabsAt({{0.0, kR, 0.0}}));
+        } catch (const Cancelled&) {
+            cancelled = true;
+            sculptor.restoreRecording();
+        }
+        stopped += cancelled;
+        EXPECT_EQ(test::differingBits(sculptor.grid(), *start) == 0, cancelled) << n;
+    }
+    // Stopped before, within and after the filter, and within the renormalization.
+    EXPECT_GE(stopped, 4);
 }

@@ -146,6 +146,11 @@ TEST(StrokeScript, BadInputIsRefusedWithFileLocationAndReason) {
              R"({"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3, "path": [{"t": [0,0,0]}]}]})"),
          "/strokes/0/tools/0/path", "at least two placements"},
         {withStroke(R"({"type": "smudge"})"), "/strokes/0/type", "unknown stroke type \"smudge\""},
+        {withStroke(R"({"type": "sweep", "strength": 1.5, "tools": [{)" + kGoodTool + R"(}]})"),
+         "/strokes/0/strength", "at most 1"},
+        {withStroke(
+             R"({"type": "smooth", "strength": 10.5, "tool": {"shape": "ball", "size": 0.3, "falloff": 0.3, "path": [{"t": [0,0,0]}]}})"),
+         "/strokes/0/strength", "at most 10"},
         {withStroke(R"({"type": "sweep", "tools": [{)" + kGoodTool + R"(, "fallof": 0.2}]})"),
          "/strokes/0/tools/0/fallof", "unknown field"},
         {withStroke(
