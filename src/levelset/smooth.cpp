@@ -53,8 +53,8 @@ CurvatureSmoother::CurvatureSmoother(Grid& grid, const SmoothBrush& brush, Inter
                                      const SmoothOptions& options)
     : grid_(grid), brush_(brush), interrupter_(interrupter), options_(options) {
     const double h = grid.voxelSize()[0];
-    const openvdb::Vec3d c =
-        grid.worldToIndex({brush.center.x(), brush.center.y(), brush.center.z()});
+    centre_ = grid.worldToIndex({brush.center.x(), brush.center.y(), brush.center.z()});
+    const openvdb::Vec3d c = centre_;
     // The brush's reach, the band around it (renormalization rebuilds the band there) and
     // the voxel the central differences read beyond it.
     const double margin = reachRadius() / h + 2.0;
@@ -79,9 +79,8 @@ const SmoothStats& CurvatureSmoother::plan() {
     std::vector<Leaf*> around;
     if (options_.scheme != SmoothScheme::ExplicitFlow &&
         sigmaVoxels() >= DistanceFilter::kSmallestSigma) {
-        const openvdb::Vec3d c =
-            grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
-        filter_ = std::make_unique<DistanceFilter>(grid_, sigmaVoxels(), openvdb::Coord::round(c));
+        filter_ =
+            std::make_unique<DistanceFilter>(grid_, sigmaVoxels(), openvdb::Coord::round(centre_));
         // The splat's, blur's and slice's reach around the voxels that flow, in voxels.
         const DistanceFilterStats& f = filter_->stats();
         const int grow = (f.radius + 2) * f.spacing + 1;
@@ -128,8 +127,7 @@ SmoothStats CurvatureSmoother::run() {
 }
 
 bool CurvatureSmoother::leafNear(const openvdb::Coord& origin, double radius) const {
-    const openvdb::Vec3d c =
-        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+    const openvdb::Vec3d c = centre_;
     const openvdb::Vec3d lo = origin.asVec3d(), hi = lo + openvdb::Vec3d(Leaf::DIM - 1);
     const openvdb::Vec3d nearest(std::clamp(c.x(), lo.x(), hi.x()),
                                  std::clamp(c.y(), lo.y(), hi.y()),
@@ -139,8 +137,7 @@ bool CurvatureSmoother::leafNear(const openvdb::Coord& origin, double radius) co
 
 std::vector<CurvatureSmoother::Leaf*> CurvatureSmoother::leavesIn(double radius) {
     std::vector<Leaf*> leaves;
-    const openvdb::Vec3d c =
-        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+    const openvdb::Vec3d c = centre_;
     const openvdb::CoordBBox box(openvdb::Coord::floor(c - openvdb::Vec3d(radius)),
                                  openvdb::Coord::ceil(c + openvdb::Vec3d(radius)));
     const auto near = [&](const openvdb::Coord& origin) { return leafNear(origin, radius); };
@@ -178,29 +175,28 @@ std::vector<CurvatureSmoother::Leaf*> CurvatureSmoother::leavesIn(double radius)
     return leaves;
 }
 
-void CurvatureSmoother::weigh() {
-    const double r = brush_.radius, f = brush_.falloff, h = grid_.voxelSize()[0];
-    const float bg = grid_.background();
+float CurvatureSmoother::weightAt(const openvdb::Coord& ijk) const {
     // Distances in index space times h (the grid's map is a uniform scale, turned and
     // moved).
-    const openvdb::Vec3d c =
-        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+    const double d = (ijk.asVec3d() - centre_).length() * grid_.voxelSize()[0] - brush_.radius;
+    return float(falloffMu(d, brush_.falloff));
+}
+
+void CurvatureSmoother::weigh() {
+    const float bg = grid_.background();
     // Band voxels within the falloff's reach (not those at +-background: they hold no
     // distance). Leaves wholly beyond it are passed over.
-    weight_.resize(leaves_.size());
     std::vector<leafwords::Words> words(leaves_.size());
-    const double reached = (r + f) / h + 1.0;
+    const double reached = (brush_.radius + brush_.falloff) / grid_.voxelSize()[0] + 1.0;
     parallelFor(tbb::blocked_range<std::size_t>(0, leaves_.size()), [&](const auto& range) {
         for (std::size_t l = range.begin(); l != range.end(); ++l) {
             const Leaf& leaf = *leaves_[l];
             words[l].fill(0);
             if (!leafNear(leaf.origin(), reached)) continue;
             for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
-                weight_[l][i] = 0.0f;
                 if (!leaf.isValueOn(i) || std::abs(leaf.getValue(i)) >= bg) continue;
-                const double d = (leaf.offsetToGlobalCoord(i).asVec3d() - c).length() * h - r;
-                weight_[l][i] = float(falloffMu(d, f));
-                if (weight_[l][i] > 0.0f) words[l][i >> 6] |= leafwords::Word(1) << (i & 63);
+                if (weightAt(leaf.offsetToGlobalCoord(i)) > 0.0f)
+                    words[l][i >> 6] |= leafwords::Word(1) << (i & 63);
             }
         }
     });
@@ -220,25 +216,43 @@ void CurvatureSmoother::weigh() {
 // them distances, or drops them past the half-width.
 void CurvatureSmoother::widenBand(int layers) {
     if (layers <= 0) return;
-    const openvdb::Vec3d c =
-        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+    const openvdb::Vec3d c = centre_;
     const double r = renormalizedRadius();
-    for (const LeafVoxels& lv : dilatedByCube(weighted_, layers)) {
-        Leaf* leaf = grid_.tree().probeLeaf(lv.origin);
-        const bool made = !leaf;
-        LeafVoxels fresh{lv.origin, {}};
-        for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
-            if (!((lv.words[i >> 6] >> (i & 63)) & 1)) continue;
-            if (((lv.origin + Leaf::offsetToLocalCoord(i)).asVec3d() - c).lengthSqr() > r * r)
-                continue;
-            if (!leaf) leaf = grid_.tree().touchLeaf(lv.origin);
-            if (leaf->isValueOn(i)) continue;
-            leaf->setValueOn(i);
-            fresh.words[i >> 6] |= leafwords::Word(1) << (i & 63);
+    VoxelList grown = dilatedByCube(weighted_, layers); // each leaf once
+    std::vector<Leaf*> leaf(grown.size(), nullptr);
+    parallelFor(tbb::blocked_range<std::size_t>(0, grown.size()), [&](const auto& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            LeafVoxels& lv = grown[k];
+            for (openvdb::Index i = 0; i < Leaf::SIZE; ++i)
+                if (((lv.origin + Leaf::offsetToLocalCoord(i)).asVec3d() - c).lengthSqr() > r * r)
+                    lv.words[i >> 6] &= ~(leafwords::Word(1) << (i & 63));
+            if (leafwords::any(lv.words)) leaf[k] = grid_.tree().probeLeaf(lv.origin);
         }
-        if (made && leaf) leaves_.push_back(leaf); // renormalized with the others
-        if (leafwords::any(fresh.words)) fresh_.push_back(fresh);
-    }
+    });
+    // Leaves the band grows into are made one by one (the tree's structure changes) and
+    // renormalized with the others; then each leaf's voxels join in parallel.
+    for (std::size_t k = 0; k < grown.size(); ++k)
+        if (!leaf[k] && leafwords::any(grown[k].words)) {
+            leaf[k] = grid_.tree().touchLeaf(grown[k].origin);
+            leaves_.push_back(leaf[k]);
+        }
+    std::vector<leafwords::Words> fresh(grown.size());
+    parallelFor(tbb::blocked_range<std::size_t>(0, grown.size()), [&](const auto& range) {
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            fresh[k].fill(0);
+            if (!leaf[k]) continue;
+            for (std::size_t w = 0; w < 8; ++w) {
+                const leafwords::Word added =
+                    grown[k].words[w] &
+                    ~leaf[k]->valueMask().template getWord<leafwords::Word>(openvdb::Index(w));
+                fresh[k][w] = added;
+            }
+            for (openvdb::Index i = 0; i < Leaf::SIZE; ++i)
+                if ((fresh[k][i >> 6] >> (i & 63)) & 1) leaf[k]->setValueOn(i);
+        }
+    });
+    for (std::size_t k = 0; k < grown.size(); ++k)
+        if (leafwords::any(fresh[k])) fresh_.push_back({grown[k].origin, fresh[k]});
 }
 
 double CurvatureSmoother::stepCount() const {
@@ -294,10 +308,18 @@ void CurvatureSmoother::flow() {
         const float* values = leaves_[flowing_[k]]->buffer().data();
         std::copy(values, values + Leaf::SIZE, start[k].begin());
     }
+    // The brush's weight at every voxel that flows, read at each step.
+    std::vector<std::array<float, Leaf::SIZE>> weight(flowing_.size());
     std::vector<PaddedLeaf::Around> around(flowing_.size());
     parallelFor(tbb::blocked_range<std::size_t>(0, flowing_.size()), [&](const auto& range) {
-        for (std::size_t k = range.begin(); k != range.end(); ++k)
-            around[k] = PaddedLeaf::around(grid_, *leaves_[flowing_[k]]);
+        for (std::size_t k = range.begin(); k != range.end(); ++k) {
+            const Leaf& leaf = *leaves_[flowing_[k]];
+            around[k] = PaddedLeaf::around(grid_, leaf);
+            for (openvdb::Index i = 0; i < Leaf::SIZE; ++i)
+                weight[k][i] = ((weighted_[k].words[i >> 6] >> (i & 63)) & 1)
+                                   ? weightAt(leaf.offsetToGlobalCoord(i))
+                                   : 0.0f;
+        }
     });
     tbb::enumerable_thread_specific<std::size_t> updates(0);
     for (int s = 0; s < steps; ++s) {
@@ -310,9 +332,8 @@ void CurvatureSmoother::flow() {
                     const int x = int(i >> 6), y = int((i >> 3) & 7), z = int(i & 7);
                     const float p = block.at(x, y, z);
                     next[k][i] = p;
-                    if (weight_[flowing_[k]][i] == 0.0f) continue;
-                    const double moved =
-                        p + dt * weight_[flowing_[k]][i] * curvatureTerm(block, x, y, z, h);
+                    if (weight[k][i] == 0.0f) continue;
+                    const double moved = p + dt * weight[k][i] * curvatureTerm(block, x, y, z, h);
                     next[k][i] = std::clamp(float(moved), start[k][i] - most, start[k][i] + most);
                     ++n;
                 }
@@ -357,8 +378,9 @@ void CurvatureSmoother::filter() {
         for (std::size_t k = range.begin(); k != range.end(); ++k) {
             const Leaf& leaf = *leaves_[flowing_[k]];
             block.load(PaddedLeaf::around(grid_, leaf));
+            const leafwords::Words& weighted = weighted_[k].words;
             for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
-                if (weight_[flowing_[k]][i] == 0.0f) continue;
+                if (!((weighted[i >> 6] >> (i & 63)) & 1)) continue;
                 const int x = int(i >> 6), y = int((i >> 3) & 7), z = int(i & 7);
                 // Central differences, or one-sided ones where a neighbour lies past the band
                 // (its value is the background, no distance).
@@ -377,9 +399,9 @@ void CurvatureSmoother::filter() {
             for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
                 const float p = values[i];
                 next[k][i] = p;
-                if (weight_[flowing_[k]][i] == 0.0f || !std::isfinite(u[i])) continue;
-                const float moved = std::clamp(p + weight_[flowing_[k]][i] * (u[i] * float(h) - p),
-                                               p - most, p + most);
+                if (!((weighted[i >> 6] >> (i & 63)) & 1) || !std::isfinite(u[i])) continue;
+                const float w = weightAt(leaf.offsetToGlobalCoord(i));
+                const float moved = std::clamp(p + w * (u[i] * float(h) - p), p - most, p + most);
                 if (!(std::abs(moved - p) >= nudge)) continue;
                 next[k][i] = moved;
                 changed_[k].words[i >> 6] |= leafwords::Word(1) << (i & 63);
@@ -401,8 +423,7 @@ void CurvatureSmoother::filter() {
 void CurvatureSmoother::renormalizeReach() {
     // The voxels within the reach less a voxel: beyond them every value stays as it was (the
     // box's corners too) but for an inactive voxel next to them that the band takes in.
-    const openvdb::Vec3d c =
-        grid_.worldToIndex({brush_.center.x(), brush_.center.y(), brush_.center.z()});
+    const openvdb::Vec3d c = centre_;
     const double r = renormalizedRadius();
     const auto clip = [&](LeafVoxels& lv) {
         for (openvdb::Index i = 0; i < Leaf::SIZE; ++i)

@@ -109,6 +109,8 @@ class CurvatureSmoother {
     // The leaves of the grid with a voxel within `radius` voxels of the brush's centre.
     std::vector<Leaf*> leavesIn(double radius);
     bool leafNear(const openvdb::Coord& origin, double radius) const;
+    // The brush's weight at a voxel: 1 inside the ball, mu of 3.2 across the falloff.
+    float weightAt(const openvdb::Coord& ijk) const;
     void weigh(); // the brush's weight at each band voxel, and the leaves that flow
     // SmoothStats' work (and the filter's plan, reading the band of `around`).
     void estimateWork(const std::vector<Leaf*>& around);
@@ -123,11 +125,10 @@ class CurvatureSmoother {
     Interrupter* interrupter_;
     SmoothOptions options_;
     openvdb::CoordBBox reach_;
+    openvdb::Vec3d centre_; // the brush's centre, in index space
     std::vector<Leaf*> leaves_;
-    // The leaves that flow (index into leaves_), and the voxels with a weight of each; the
-    // brush's weight at every voxel, by leaf (set for the leaves that flow).
+    // The leaves that flow (index into leaves_), and the voxels with a weight of each.
     std::vector<std::size_t> flowing_;
-    std::vector<std::array<float, Leaf::SIZE>> weight_;
     VoxelList weighted_;
     VoxelList changed_, fresh_; // what the filter changed, and the voxels the band grew by
     std::unique_ptr<DistanceFilter> filter_;

@@ -97,7 +97,7 @@ void registerBrushBenchmarks() {
         for (const int div : divisions)
             for (const bool flow : {false, true}) {
                 // A smooth dab's reference: the explicit flow, in the same run.
-                if (flow && !smooth) continue;
+                if (flow && (!smooth || c.only256)) continue;
                 add(
                     std::string("brushes/") + c.name + "_h" + std::to_string(div) +
                         (flow ? "/explicit_flow" : "/sweepers"),
