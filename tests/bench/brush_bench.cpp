@@ -58,6 +58,12 @@ const BrushCase kCases[] = {
          "tool": {"shape": "ball", "size": 0.25, "falloff": 0.25,
                   "path": [{"t": [0.3, 0.954, 0]}, {"t": [0.32, 0.947, 0]}]}})",
      false},
+    // Strength 10, the most: a flow time ten times the default dab's.
+    {"smooth_strength10", R"({"type": "smooth", "strength": 10,
+                             "tool": {"shape": "ball", "size": 0.25, "falloff": 0.25,
+                             "path": [{"t": [0, 1, 0]}, {"t": [0.05, 0.999, 0]},
+                                      {"t": [0.1, 0.995, 0]}, {"t": [0.15, 0.989, 0]}]}})",
+     true},
     // The modeler's largest ball: on the unit sphere it covers the whole surface, about 16
     // times the footprint of the ball of 0.25 with its falloff.
     {"smooth_radius2", R"({"type": "smooth", "tool": {"shape": "ball", "size": 2, "falloff": 0.25,
