@@ -129,64 +129,95 @@ void DistanceFilter::splat() {
     const int m = m_;
     const float inv = 1.0f / float(m);
     parallelFor(tbb::blocked_range<std::size_t>(0, origin_.size()), [&](const auto& range) {
+        // A leaf's sums along z (by row and z node), then along y (by x, y node and z node).
+        std::vector<float> alongZ, alongY;
         for (std::size_t b = range.begin(); b != range.end(); ++b) {
             Block& out = a_[b];
             out.f.fill(0.0f);
             const openvdb::Coord first = origin_[b];
             for (const int l : splatFrom_[b]) {
                 const Leaf& leaf = *leaves_[std::size_t(l)];
-                // Along each axis, for each of the leaf's 8 coordinates: the node at or below
-                // it in this block (0 to 7, or outside) and the weights of it and the next.
+                const openvdb::Coord o = leaf.origin(), lo = floorDiv(o, m);
+                // Along each axis, for each of the leaf's 8 coordinates: its node (at or below
+                // it, from the leaf's first node) and the weights of that node and the next.
                 struct Axis {
                     std::array<int, 8> node;
                     std::array<float, 8> w0, w1;
-                    std::array<bool, 8> in0, in1;
+                    int nodes = 0;
                 };
                 std::array<Axis, 3> axes;
-                for (int a = 0; a < 3; ++a)
+                for (int a = 0; a < 3; ++a) {
+                    Axis& ax = axes[std::size_t(a)];
                     for (int c = 0; c < 8; ++c) {
-                        const int x = leaf.origin()[a] + c, k0 = floorDiv(x, m), o = x - k0 * m;
-                        Axis& ax = axes[std::size_t(a)];
-                        ax.node[std::size_t(c)] = k0 - first[a];
-                        ax.w0[std::size_t(c)] = float(m - o) * inv;
-                        ax.w1[std::size_t(c)] = float(o) * inv;
-                        ax.in0[std::size_t(c)] = k0 >= first[a] && k0 <= first[a] + 7;
-                        ax.in1[std::size_t(c)] =
-                            o > 0 && k0 + 1 >= first[a] && k0 + 1 <= first[a] + 7;
+                        const int x = o[a] + c, k0 = floorDiv(x, m), r = x - k0 * m;
+                        ax.node[std::size_t(c)] = k0 - lo[a];
+                        ax.w0[std::size_t(c)] = float(m - r) * inv;
+                        ax.w1[std::size_t(c)] = float(r) * inv;
                     }
+                    ax.nodes = floorDiv(o[a] + 6 + m, m) - lo[a] + 1;
+                }
+                const Axis &X = axes[0], &Y = axes[1], &Z = axes[2];
+                const std::size_t nz = std::size_t(Z.nodes), ny = std::size_t(Y.nodes);
+                // The separable tent, one axis at a time: each voxel's 5 values into its two
+                // z nodes, each row's z nodes into two y nodes, each slice into two x nodes.
+                alongZ.assign(64 * nz * kFields, 0.0f);
                 const float* v = leaf.buffer().data();
                 const auto& mask = leaf.valueMask();
-                for (int x = 0; x < 8; ++x) {
-                    const Axis& X = axes[0];
-                    if (!X.in0[std::size_t(x)] && !X.in1[std::size_t(x)]) continue;
+                std::array<bool, 64> row{};
+                for (int x = 0; x < 8; ++x)
                     for (int y = 0; y < 8; ++y) {
-                        const Axis& Y = axes[1];
-                        if (!Y.in0[std::size_t(y)] && !Y.in1[std::size_t(y)]) continue;
+                        const std::size_t r = std::size_t(x * 8 + y);
+                        float* g = alongZ.data() + r * nz * kFields;
+                        const openvdb::Coord rel = o.offsetBy(x, y, 0) - center_;
                         for (int z = 0; z < 8; ++z) {
-                            const Axis& Z = axes[2];
-                            if (!Z.in0[std::size_t(z)] && !Z.in1[std::size_t(z)]) continue;
-                            const openvdb::Index i = openvdb::Index(x * 64 + y * 8 + z);
+                            const openvdb::Index i = openvdb::Index(r * 8 + std::size_t(z));
                             if (!mask.isOn(i) || !(std::abs(v[i]) < bg)) continue;
-                            const openvdb::Coord rel = leaf.origin().offsetBy(x, y, z) - center_;
+                            row[r] = true;
                             const float values[kFields] = {1.0f, v[i] * toVoxels, float(rel.x()),
-                                                           float(rel.y()), float(rel.z())};
-                            for (int dx = 0; dx < 2; ++dx) {
-                                if (!(dx ? X.in1 : X.in0)[std::size_t(x)]) continue;
-                                const float wx = (dx ? X.w1 : X.w0)[std::size_t(x)];
-                                const int nx = X.node[std::size_t(x)] + dx;
-                                for (int dy = 0; dy < 2; ++dy) {
-                                    if (!(dy ? Y.in1 : Y.in0)[std::size_t(y)]) continue;
-                                    const float wxy = wx * (dy ? Y.w1 : Y.w0)[std::size_t(y)];
-                                    const int ny = Y.node[std::size_t(y)] + dy;
-                                    for (int dz = 0; dz < 2; ++dz) {
-                                        if (!(dz ? Z.in1 : Z.in0)[std::size_t(z)]) continue;
-                                        const float w = wxy * (dz ? Z.w1 : Z.w0)[std::size_t(z)];
-                                        const std::size_t at =
-                                            offset(nx, ny, Z.node[std::size_t(z)] + dz);
-                                        for (int f = 0; f < kFields; ++f)
-                                            out.f[std::size_t(f) * 512 + at] += w * values[f];
-                                    }
-                                }
+                                                           float(rel.y()), float(rel.z() + z)};
+                            const std::size_t k = std::size_t(Z.node[std::size_t(z)]);
+                            for (int f = 0; f < kFields; ++f) {
+                                g[k * kFields + std::size_t(f)] += Z.w0[std::size_t(z)] * values[f];
+                                g[(k + 1) * kFields + std::size_t(f)] +=
+                                    Z.w1[std::size_t(z)] * values[f];
+                            }
+                        }
+                    }
+                alongY.assign(8 * ny * nz * kFields, 0.0f);
+                std::array<bool, 8> slice{};
+                for (int x = 0; x < 8; ++x)
+                    for (int y = 0; y < 8; ++y) {
+                        const std::size_t r = std::size_t(x * 8 + y);
+                        if (!row[r]) continue;
+                        slice[std::size_t(x)] = true;
+                        const float* g = alongZ.data() + r * nz * kFields;
+                        const std::size_t k = std::size_t(Y.node[std::size_t(y)]);
+                        float* h0 = alongY.data() + (std::size_t(x) * ny + k) * nz * kFields;
+                        float* h1 = h0 + nz * kFields;
+                        const float w0 = Y.w0[std::size_t(y)], w1 = Y.w1[std::size_t(y)];
+                        for (std::size_t j = 0; j < nz * kFields; ++j) {
+                            h0[j] += w0 * g[j];
+                            h1[j] += w1 * g[j];
+                        }
+                    }
+                for (int x = 0; x < 8; ++x) {
+                    if (!slice[std::size_t(x)]) continue;
+                    for (int dx = 0; dx < 2; ++dx) {
+                        const int nx = lo.x() + X.node[std::size_t(x)] + dx - first.x();
+                        const float wx = dx ? X.w1[std::size_t(x)] : X.w0[std::size_t(x)];
+                        if (nx < 0 || nx > 7 || wx == 0.0f) continue;
+                        for (std::size_t ky = 0; ky < ny; ++ky) {
+                            const int yy = lo.y() + int(ky) - first.y();
+                            if (yy < 0 || yy > 7) continue;
+                            const float* h =
+                                alongY.data() + (std::size_t(x) * ny + ky) * nz * kFields;
+                            for (std::size_t kz = 0; kz < nz; ++kz) {
+                                const int zz = lo.z() + int(kz) - first.z();
+                                if (zz < 0 || zz > 7) continue;
+                                const std::size_t at = offset(nx, yy, zz);
+                                for (int f = 0; f < kFields; ++f)
+                                    out.f[std::size_t(f) * 512 + at] +=
+                                        wx * h[kz * kFields + std::size_t(f)];
                             }
                         }
                     }

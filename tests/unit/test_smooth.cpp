@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include <atomic>
+#include <set>
 
 #include <openvdb/math/Stencils.h>
 #include <openvdb/tools/Interpolation.h>
@@ -331,8 +332,10 @@ TEST(Smooth, RidgesFadeAsTheLawSays) {
     std::vector<double> sizes{1.0 / 64, 1.0 / 128, 1.0 / 256};
     if (test::coarse()) sizes.pop_back();
     for (const double h : sizes) {
-        for (const double l : {4 * h, 8 * h, 16 * h, r}) {
-            if (l > r || (l == r && r <= 16 * h)) continue; // beyond the ball, or run already
+        std::set<double> lengths;
+        for (const double l : {4 * h, 8 * h, 16 * h, r})
+            if (l <= r) lengths.insert(l); // (the ball's radius may be one of the others)
+        for (const double l : lengths) {
             const double amplitude = std::min(0.1 * h * (l / (4 * h)), 0.25 * h);
             const GridPtr start = ridgedSphere(h, l, amplitude);
             SmoothStats s;
