@@ -43,11 +43,12 @@ DistanceFilter::DistanceFilter(const Grid& grid, double sigma, const openvdb::Co
     // 3.5 standard deviations (the weight left out is about 5e-4 of the whole); a block's
     // neighbours hold it (the lattice's sigma stays below 1.3 nodes for m >= 2: 5 nodes).
     stats_.radius = std::min(8, int(std::ceil(3.5 * stats_.latticeSigma)));
-    kernel_.resize(std::size_t(2 * stats_.radius + 1));
+    kernel_.resize(std::size_t(stats_.radius) * 2 + 1);
     double sum = 0.0;
     for (int d = -stats_.radius; d <= stats_.radius; ++d) {
         const double w = std::exp(-0.5 * d * d / (stats_.latticeSigma * stats_.latticeSigma));
-        kernel_[std::size_t(d + stats_.radius)] = float(w);
+        const int at = d + stats_.radius;
+        kernel_[std::size_t(at)] = float(w);
         sum += w;
     }
     for (float& w : kernel_)
@@ -106,7 +107,7 @@ void DistanceFilter::plan(const std::vector<const Leaf*>& leaves, const VoxelLis
             for (int side = 0; side < 2; ++side) {
                 openvdb::Coord n = origin_[b];
                 n[axis] += side ? 8 : -8;
-                neighbour_[b][std::size_t(2 * axis + side)] = blockOf(n);
+                neighbour_[b][std::size_t(axis) * 2 + std::size_t(side)] = blockOf(n);
             }
     stats_.inputLeaves = 0;
     for (const auto& from : splatFrom_)
@@ -166,7 +167,7 @@ void DistanceFilter::splat() {
                 std::array<bool, 64> row{};
                 for (int x = 0; x < 8; ++x)
                     for (int y = 0; y < 8; ++y) {
-                        const std::size_t r = std::size_t(x * 8 + y);
+                        const std::size_t r = std::size_t(x) * 8 + std::size_t(y);
                         float* g = alongZ.data() + r * nz * kFields;
                         const openvdb::Coord rel = o.offsetBy(x, y, 0) - center_;
                         for (int z = 0; z < 8; ++z) {
@@ -187,7 +188,7 @@ void DistanceFilter::splat() {
                 std::array<bool, 8> slice{};
                 for (int x = 0; x < 8; ++x)
                     for (int y = 0; y < 8; ++y) {
-                        const std::size_t r = std::size_t(x * 8 + y);
+                        const std::size_t r = std::size_t(x) * 8 + std::size_t(y);
                         if (!row[r]) continue;
                         slice[std::size_t(x)] = true;
                         const float* g = alongZ.data() + r * nz * kFields;
@@ -240,30 +241,34 @@ void DistanceFilter::pass(int axis, const std::vector<int>& blocks, const std::v
     parallelFor(tbb::blocked_range<std::size_t>(0, blocks.size()), [&](const auto& range) {
         for (std::size_t k = range.begin(); k != range.end(); ++k) {
             const std::size_t b = std::size_t(blocks[k]);
-            const int before = neighbour_[b][std::size_t(2 * axis)],
-                      after = neighbour_[b][std::size_t(2 * axis + 1)];
+            const int before = neighbour_[b][std::size_t(axis) * 2],
+                      after = neighbour_[b][std::size_t(axis) * 2 + 1];
             const Block* parts[3] = {before >= 0 ? &from[std::size_t(before)] : nullptr, &from[b],
                                      after >= 0 ? &from[std::size_t(after)] : nullptr};
             Block& out = to[b];
             if (inner == 1) {
                 // Along z each row is 8 contiguous values: the row and its neighbours' side by
                 // side, and the 8 outputs summed tap by tap.
-                for (std::size_t row = 0; row < kFields * 64; ++row) {
+                for (std::size_t row = 0; row < std::size_t(kFields) * 64; ++row) {
                     std::array<float, 24> line{};
                     for (int part = 0; part < 3; ++part)
                         if (parts[part])
-                            std::copy_n(parts[part]->f.data() + row * 8, 8, line.data() + part * 8);
+                            std::copy_n(parts[part]->f.data() + row * 8, 8,
+                                        line.data() + std::size_t(part) * 8);
                     std::array<float, 8> sum{};
                     for (int d = -radius; d <= radius; ++d)
-                        for (int p = 0; p < 8; ++p)
-                            sum[std::size_t(p)] += kernel[d] * line[std::size_t(8 + p + d)];
+                        for (int p = 0; p < 8; ++p) {
+                            const int q = 8 + p + d; // in the row and its neighbours
+                            sum[std::size_t(p)] += kernel[d] * line[std::size_t(q)];
+                        }
                     std::copy(sum.begin(), sum.end(), out.f.data() + row * 8);
                 }
                 continue;
             }
             for (int f = 0; f < kFields; ++f)
                 for (int o = 0; o < outer; ++o) {
-                    const std::size_t first = std::size_t(f * 512 + o * 8 * inner);
+                    const std::size_t first =
+                        std::size_t(f) * 512 + std::size_t(o) * 8 * std::size_t(inner);
                     for (int p = 0; p < 8; ++p) {
                         float* row = out.f.data() + first + std::size_t(p * inner);
                         std::fill(row, row + inner, 0.0f);
@@ -320,17 +325,18 @@ void DistanceFilter::read(const openvdb::Coord& origin, const leafwords::Words& 
                 const int b = blockOf(first.offsetBy(8 * bx, 8 * by, 8 * bz));
                 // Only the blocks the z pass made hold the blur.
                 if (b >= 0 && std::size_t(b) < pass_[2].size())
-                    blocks[std::size_t(bx * 4 + by * 2 + bz)] = &b_[std::size_t(b)];
+                    blocks[std::size_t(bx) * 4 + std::size_t(by) * 2 + std::size_t(bz)] =
+                        &b_[std::size_t(b)];
             }
     std::array<std::array<float, 4>, 729> node;
     for (int x = 0; x < n.x(); ++x)
         for (int y = 0; y < n.y(); ++y)
             for (int z = 0; z < n.z(); ++z) {
                 const openvdb::Coord local = lo.offsetBy(x, y, z) - first;
-                auto& to = node[std::size_t((x * 9 + y) * 9 + z)];
+                auto& to = node[(std::size_t(x) * 9 + std::size_t(y)) * 9 + std::size_t(z)];
                 to = {kNone, kNone, kNone, kNone};
-                const Block* block = blocks[std::size_t((local.x() >> 3) * 4 +
-                                                        (local.y() >> 3) * 2 + (local.z() >> 3))];
+                const int which = (local.x() >> 3) * 4 + (local.y() >> 3) * 2 + (local.z() >> 3);
+                const Block* block = blocks[std::size_t(which)];
                 if (!block) continue;
                 const std::size_t at = offset(local.x() & 7, local.y() & 7, local.z() & 7);
                 if (!(block->f[at] > 0.0f)) continue;
@@ -350,8 +356,8 @@ void DistanceFilter::read(const openvdb::Coord& origin, const leafwords::Words& 
                 const float wy = dy ? float(o.y()) * inv : float(m_ - o.y()) * inv;
                 for (int dz = 0; dz <= (o.z() > 0); ++dz) {
                     const float wz = dz ? float(o.z()) * inv : float(m_ - o.z()) * inv;
-                    const auto& v = node[std::size_t(((local.x() + dx) * 9 + local.y() + dy) * 9 +
-                                                     local.z() + dz)];
+                    const int at = ((local.x() + dx) * 9 + local.y() + dy) * 9 + local.z() + dz;
+                    const auto& v = node[std::size_t(at)];
                     const float w = wx * wy * wz;
                     for (std::size_t f = 0; f < 4; ++f)
                         sum[f] += w * v[f];

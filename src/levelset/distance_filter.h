@@ -19,14 +19,13 @@
 //   The linear part of d cancels whatever the band's shape about x, so what remains is the
 //   average of d's departure from its tangent plane at x: its curvature term.
 // - The sums are smooth at the scale sigma, so they are taken on a lattice of spacing m
-//   voxels (m about sigma / 1.15): each band voxel is splatted onto the 8 lattice nodes
+//   voxels (m about 1.1 sigma): each band voxel is splatted onto the 8 lattice nodes
 //   around it with trilinear weights, the lattice is blurred by a separable sampled
 //   Gaussian, and each voxel asked for reads the 8 nodes around it back (the splat, blur and
 //   slice of Paris and Durand's bilateral grid, ECCV 2006). The splat and the slice each
 //   blur by a variance of (m^2 - 1) / 6 voxels^2 on each axis, which the lattice's Gaussian
-//   leaves out. A lattice node is one voxel at m = 1, so the work is a few dozen operations
-//   per band voxel and a few hundred per lattice node near the band, whose count stays the
-//   same as the voxels get finer.
+//   leaves out. The work is a few dozen operations per band voxel and a few hundred per
+//   lattice node near the band, whose count stays the same as the voxels get finer.
 //
 // Every node and voxel is summed in one fixed order: the result is the same at any thread
 // count, bit for bit.
@@ -81,7 +80,7 @@ class DistanceFilter {
   private:
     static constexpr int kFields = 5; // weight, weighted distance, weighted offset x, y, z
     struct Block {
-        std::array<float, kFields * 512> f; // field k at k * 512 + x * 64 + y * 8 + z
+        std::array<float, std::size_t(kFields) * 512> f; // field k at k * 512 + x * 64 + y * 8 + z
     };
     struct CoordHash {
         std::size_t operator()(const openvdb::Coord& c) const {

@@ -1,18 +1,20 @@
 // Smoothing under a brush: the level sets relax by mean-curvature flow,
 //     d phi / dt = w(x) kappa |grad phi|,   kappa = div(grad phi / |grad phi|),
 // for a flow time t, weighted by the brush's falloff w (1 inside the ball, mu of 3.2 across
-// the falloff, 0 beyond), then the touched box is renormalized. Bumps of wavelength l fade
-// like exp(-(2 pi / l)^2 t): fine noise goes first, the form under the brush last.
+// the falloff, 0 beyond). Bumps of wavelength l fade like exp(-(2 pi / l)^2 t): fine noise
+// goes first, the form under the brush last.
 //
-// Two schemes give it:
-// - the filter (the default): the distance blurred by a Gaussian of standard deviation
-//   sqrt(2 t) (levelset/distance_filter.h: a step of Esedoglu, Ruuth and Tsai's diffusion
+// Two schemes give it, a dab running the one that counts less work:
+// - the filter: the distance blurred by a Gaussian of standard deviation sqrt(2 t)
+//   (levelset/distance_filter.h: a step of Esedoglu, Ruuth and Tsai's diffusion
 //   generated motion), each voxel under the brush taking w times the way from its value to
-//   the blurred one. Its work follows the band under the brush, (r/h)^2, whatever t;
+//   the blurred one, then renormalized where values changed, as after a segment. Its work
+//   follows the band under the brush, (r/h)^2, whatever t;
 // - the explicit flow: steps of the equation above by central differences, stable for
 //   dt <= h^2 / 4, so t / dt of them, (r/h)^2 steps of (r/h)^2 voxels. It is the reference
 //   the filter is tested against, and what a dab runs where it takes less work than the
-//   filter: a short dab of a few steps, whose Gaussian would be about a voxel wide.
+//   filter: a short dab of a few steps, whose Gaussian would be about a voxel wide. The
+//   ball it reaches is renormalized.
 // No value moves more than two voxels in a dab.
 //
 // Unlike every other stroke this is not a deformation of space: the velocity is the
@@ -111,7 +113,7 @@ class CurvatureSmoother {
     bool leafNear(const openvdb::Coord& origin, double radius) const;
     // The brush's weight at a voxel: 1 inside the ball, mu of 3.2 across the falloff.
     float weightAt(const openvdb::Coord& ijk) const;
-    void weigh(); // the brush's weight at each band voxel, and the leaves that flow
+    void weigh(); // the band voxels with a weight, and the leaves that flow
     // SmoothStats' work (and the filter's plan, reading the band of `around`).
     void estimateWork(const std::vector<Leaf*>& around);
     std::string workDescription() const;
