@@ -411,13 +411,13 @@ void SculptController::moveSizing(double x, double y) {
     } else {
         // A fifth of the window's height is full strength: 1, or the smooth tool's most.
         const double pixels = std::hypot(x - sizingX_, y - sizingY_);
-        const double most = mode_ == SculptMode::Smooth ? kMostSmoothStrength : 1.0;
+        const double most = settings_.mode == SculptMode::Smooth ? kMostSmoothStrength : 1.0;
         sizedStrength() = std::clamp(most * pixels / (0.2 * height_), 0.01, most);
     }
 }
 
 double& SculptController::sizedStrength() {
-    return mode_ == SculptMode::Smooth ? settings_.smoothStrength : settings_.strength;
+    return settings_.mode == SculptMode::Smooth ? settings_.smoothStrength : settings_.strength;
 }
 
 std::optional<glm::dvec3> SculptController::toolCentre() const {

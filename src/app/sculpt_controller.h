@@ -58,7 +58,7 @@ struct ToolSettings {
     MirrorAxis mirror = MirrorAxis::None;
     double radius = 0.25, falloff = 0.25;
     // (0, 1]: the fraction of the hand's motion a grab, twist, inflate or fluid applies, of
-    // a swirl's move, of the clay ball's radius, of a smooth dab's flow time.
+    // a swirl's move, of the clay ball's radius.
     double strength = 1.0;
     // (0, kMostSmoothStrength]: a smooth dab's flow time over the default dab's (Shift-drag
     // smooths with it whatever the tool; a smooth dab is cheap enough to reach the form).

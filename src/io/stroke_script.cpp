@@ -255,7 +255,7 @@ ToolSpec readTool(const Reader& r, const json& v, const std::string& at,
     return t;
 }
 
-// A stroke's "strength": a fraction in (0, 1], 1 when not given.
+// A stroke's "strength": in (0, most] (a fraction, but for smoothing), 1 when not given.
 double readStrength(const Reader& r, const json& v, const std::string& at, double most = 1.0) {
     const auto it = v.find("strength");
     if (it == v.end()) return 1.0;

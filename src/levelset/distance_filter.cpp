@@ -177,11 +177,14 @@ void DistanceFilter::splat() {
                             const float values[kFields] = {1.0f, v[i] * toVoxels, float(rel.x()),
                                                            float(rel.y()), float(rel.z() + z)};
                             const std::size_t k = std::size_t(Z.node[std::size_t(z)]);
-                            for (int f = 0; f < kFields; ++f) {
-                                g[k * kFields + std::size_t(f)] += Z.w0[std::size_t(z)] * values[f];
-                                g[(k + 1) * kFields + std::size_t(f)] +=
-                                    Z.w1[std::size_t(z)] * values[f];
-                            }
+                            // (The next node only where the voxel lies past this one: a
+                            // voxel on a node's plane may be at the leaf's last node.)
+                            const float w0 = Z.w0[std::size_t(z)], w1 = Z.w1[std::size_t(z)];
+                            for (int f = 0; f < kFields; ++f)
+                                g[k * kFields + std::size_t(f)] += w0 * values[f];
+                            if (w1 > 0.0f)
+                                for (int f = 0; f < kFields; ++f)
+                                    g[(k + 1) * kFields + std::size_t(f)] += w1 * values[f];
                         }
                     }
                 alongY.assign(8 * ny * nz * kFields, 0.0f);
@@ -194,11 +197,13 @@ void DistanceFilter::splat() {
                         const float* g = alongZ.data() + r * nz * kFields;
                         const std::size_t k = std::size_t(Y.node[std::size_t(y)]);
                         float* h0 = alongY.data() + (std::size_t(x) * ny + k) * nz * kFields;
-                        float* h1 = h0 + nz * kFields;
                         const float w0 = Y.w0[std::size_t(y)], w1 = Y.w1[std::size_t(y)];
-                        for (std::size_t j = 0; j < nz * kFields; ++j) {
+                        for (std::size_t j = 0; j < nz * kFields; ++j)
                             h0[j] += w0 * g[j];
-                            h1[j] += w1 * g[j];
+                        if (w1 > 0.0f) {
+                            float* h1 = h0 + nz * kFields;
+                            for (std::size_t j = 0; j < nz * kFields; ++j)
+                                h1[j] += w1 * g[j];
                         }
                     }
                 for (int x = 0; x < 8; ++x) {

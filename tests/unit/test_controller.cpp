@@ -560,6 +560,24 @@ TEST(SculptController, FSizesTheBrushInTheViewAndShiftFItsStrength) {
     s.ctl.onButton(0, true, x, y + 0.1 * kHeight, false);
     EXPECT_NEAR(s.ctl.settings().strength, 0.5, 1e-12);
     EXPECT_TRUE(s.doc.script().strokes.empty());
+    // With the smooth tool, Shift-F sets smoothing's own strength, up to 10; then Shift-drag
+    // smooths with it whatever the tool.
+    s.ctl.onButton(0, false, x, y + 0.1 * kHeight, false);
+    s.ctl.onKey('O', false, false);
+    ASSERT_EQ(s.ctl.settings().mode, SculptMode::Smooth);
+    s.ctl.onMove(x, y);
+    s.ctl.onKey('F', false, true);
+    s.ctl.onMove(x, y + 0.1 * kHeight);
+    s.ctl.onButton(0, true, x, y + 0.1 * kHeight, false);
+    s.ctl.onButton(0, false, x, y + 0.1 * kHeight, false);
+    EXPECT_NEAR(s.ctl.settings().smoothStrength, 5.0, 1e-12);
+    EXPECT_NEAR(s.ctl.settings().strength, 0.5, 1e-12);
+    s.ctl.onKey('G', false, false);
+    dragOn(s.ctl, x, y, x + 30, y, 2, true);
+    ASSERT_FALSE(s.doc.script().strokes.empty());
+    const auto* smooth = std::get_if<SmoothStroke>(&s.doc.script().strokes.back());
+    ASSERT_NE(smooth, nullptr);
+    EXPECT_EQ(smooth->strength, 5.0);
 }
 
 TEST(SculptController, AGrabAtHalfStrengthMovesThePointUnderTheBrushHalfAsFar) {
