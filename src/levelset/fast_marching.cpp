@@ -31,6 +31,10 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr double kUnitSlack = 0.01;
+// The least drop (in voxels) across each of the two crossings along an axis for a voxel to
+// be one voxel thin (thinAlongSomeAxis): the axis meets the surface at more than about 15
+// degrees.
+constexpr double kLeastThinDrop = 0.25;
 // How far (in voxels) a seed's second-order estimate may lie from its central one before it
 // replaces it. Below this the two differ by the order of the bias that reading the grid
 // linearly (trilinear sampling, marching cubes' edge crossings) puts on a curved surface,
@@ -536,8 +540,10 @@ class Renormalizer {
         tbb::enumerable_thread_specific<std::vector<std::size_t>> found;
         forEachLeaf([&](std::size_t l) {
             forEachBit(acrossSurface(l, true), [&](int off) {
+                const std::size_t i = (l << 9) + std::size_t(off);
+                if (!thinAlongSomeAxis(i)) return;
                 set(thin_[l], off);
-                found.local().push_back((l << 9) + std::size_t(off));
+                found.local().push_back(i);
             });
         });
         std::vector<std::size_t> ring;
@@ -556,6 +562,24 @@ class Renormalizer {
                 });
             ring = std::move(next);
         }
+    }
+
+    // Whether the surface lies on both sides of voxel i along an axis it crosses at a real
+    // angle. Along an axis the surface nearly contains, values a hundredth of a voxel from it
+    // flip sign from voxel to voxel: that is the surface itself, not a feature one voxel thin,
+    // and freezing the seeds around it keeps values a third of a voxel too far. For a distance,
+    // the drop across a crossing is the cosine between the normal and the axis.
+    bool thinAlongSomeAxis(std::size_t i) const {
+        const float p = phi(i), least = float(kLeastThinDrop) * h_;
+        bool thin = false;
+        forEachAxis([&](auto a) {
+            const std::size_t lo = b_.neighbour(i, -1, a), hi = b_.neighbour(i, 1, a);
+            if (thin || lo == Domain::npos || hi == Domain::npos) return;
+            const float ql = phi(lo), qh = phi(hi);
+            thin = negative(ql) != negative(p) && negative(qh) != negative(p) &&
+                   std::abs(p - ql) >= least && std::abs(p - qh) >= least;
+        });
+        return thin;
     }
 
     float phi(std::size_t i) const { return phi_[i >> 9][i & 511]; }

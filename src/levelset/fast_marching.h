@@ -11,7 +11,8 @@
 //     over the stretch it made instead, or the second-order root where it lies more than a
 //     hundredth of a voxel from that (renormalize()). Values whose gradient (or stretch) is
 //     already unit within 1%, and values on or within two voxels of a feature one voxel thin
-//     (but for that cap), are kept, and so are seeds whose stencil a deformation did not
+//     (the surface on both sides along an axis that meets it at more than about 15 degrees;
+//     but for that cap), are kept, and so are seeds whose stencil a deformation did not
 //     change (the `moved` overload): the estimate is not idempotent where the surface
 //     curves within a voxel, and an interface seeded again and again would creep. The sign
 //     of every voxel is kept.
