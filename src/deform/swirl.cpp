@@ -33,6 +33,7 @@ SwirlSegment::SwirlSegment(const SwirlSpec& spec) : spec_(spec) {
         theta_ = len * (l2 + r2) * (l2 + r2) / (2.0 * l2 * l2 * r) / steps_; // 4.13
         reach_ =
             r * std::sqrt(std::max(0.0, std::sqrt(2.0 * M_PI * r / spec.neglect) - 1.0)); // 4.15
+        inner_ = 0.5 * reach_;
     }
     for (int k = 0; k <= steps_; ++k) {
         const Eigen::Vector3d c = ringCentre(k);
@@ -68,7 +69,26 @@ std::optional<MotionLog> SwirlSegment::stepLog(int k, const Eigen::Vector3d& p) 
         const Eigen::Vector3d eta = 2.0 * z_.cross(d);
         const double a = d.squaredNorm() + l2 + r * r;
         const double b = 2.0 * l2 * l2 * r / std::pow(a * a - r * r * eta.squaredNorm(), 1.5);
-        sum = Twist(theta_ * b * eta, theta_ * b * (c.cross(eta) + a * z_));
+        // The field is cut off at the bounding sphere through its stream function, not by
+        // itself: cut off by itself, it would pour clay through the sphere (the shape gains
+        // or loses a few tenths of a percent a swirl, at any voxel size). The field is
+        // axisymmetric about z through c with no swirl component, so it is the curl of
+        // psi (z x d) / rho^2, with Stokes stream function psi = lambda^4 / (2 r) (a / sqrt(a^2
+        // - 4 r^2 rho^2) - 1) (rho, zeta: distances from and along the axis). The curl of chi
+        // times that potential, chi going smoothly from 1 to 0 between half the reach and the
+        // reach, is the field times chi plus grad chi x the potential: divergence-free again.
+        const double dist2 = d.squaredNorm(), dist = std::sqrt(dist2);
+        const double chi = falloffMu(dist - inner_, reach_ - inner_);
+        Eigen::Vector3d translation = chi * theta_ * b * (c.cross(eta) + a * z_);
+        if (dist > inner_) {
+            const double zeta = z_.dot(d);
+            // psi / rho^2, written without the cancellation of a / sqrt(...) - 1 near the axis.
+            const double root = std::sqrt(std::max(0.0, 1.0 - r * r * eta.squaredNorm() / (a * a)));
+            const double psiOverRho2 = 2.0 * l2 * l2 * r / (a * a * root * (1.0 + root));
+            const double chiSlope = falloffMuDerivative(dist - inner_, reach_ - inner_);
+            translation += theta_ * chiSlope * psiOverRho2 / dist * (dist2 * z_ - zeta * d);
+        }
+        sum = Twist(chi * theta_ * b * eta, translation);
     }
     return MotionLog(sum);
 }

@@ -9,7 +9,8 @@
 //    exactly t: at a ring centre the swirls' rotations cancel into a translation by t/s.
 //  - Convolution ring (4.8-4.15): infinitely many swirls with the falloff gamma_lambda;
 //    their summed log has the closed form 4.11 and theta 4.13. gamma has no local support:
-//    the work is limited to the bounding sphere 4.15.
+//    the work is limited to the bounding sphere 4.15, and the field is brought to zero
+//    there through its stream function, so that it stays divergence-free (stepLog).
 //
 // As for every deformation, sub-step k is defined by its inverse with the ring at its
 // next position h_{k+1} (5.18).
@@ -53,6 +54,7 @@ class SwirlSegment : public StepDeformation {
     Eigen::Vector3d z_, u_, v_; // ring frame: z along t, u x v = z
     double theta_ = 0.0;
     double reach_ = 0.0; // distance from a ring centre beyond which nothing moves
+    double inner_ = 0.0; // convolution ring: distance within which the field is 4.11's own
 };
 
 } // namespace sweepers
