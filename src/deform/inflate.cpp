@@ -45,8 +45,11 @@ ForwardResult Inflation::forwardStep(int, const Eigen::Vector3d& q, double) cons
 }
 
 bool Inflation::fillsWith(double fromValue) const {
-    // Deeper than half the band, the thesis's ball meets the pushed surface well enough.
-    return fills_ && fromValue > -0.5 * fill_.band && fromValue < fill_.band;
+    // Within the band the new surface lies less than a voxel beyond the ball's edge (s^3 /
+    // (3 rho^2) for a ball of a few voxels at least), closer than any sampled value says.
+    // Deeper, the value at c is the band's and the surface lies farther out, where the
+    // inverse samples distances again.
+    return fills_ && fromValue > -fill_.band && fromValue < fill_.band;
 }
 
 double Inflation::filledValue(const Eigen::Vector3d& x, double value, double fromValue) const {

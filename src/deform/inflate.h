@@ -16,7 +16,7 @@
 // beyond the ball's edge, where the inverse squeezes a whole band into the centre's
 // neighbourhood (its stretch grows without bound), and the values sampled there are no
 // distances. So an inflation whose centre's value (as the grid holds it when the inflation
-// comes) lies within the band outside the surface or half of it inside fills its ball
+// comes) lies within the band, either side of the surface, fills its ball
 // (InflationFill): the value inside is the distance to the sphere of radius
 // (rho^3 + s^3)^(1/3) about c, which the new surface encloses and touches where the old
 // surface is nearest (a small fraction of a voxel from the edge), and a value sampled just

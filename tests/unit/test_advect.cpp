@@ -697,11 +697,21 @@ TEST(Advect, AWidenedBandGivesStillVoxelsTheirOwnValues) {
 // A centre a voxel and a half outside is moved onto the surface, and adds the same ball.
 TEST(Advect, AnInflationCentredOnTheSurfaceAddsOneBallOfClay) {
     const double rho = 0.4, ball = 4.0 / 3.0 * M_PI * rho * rho * rho;
-    std::vector<std::pair<int, std::size_t>> sizes = {{32, 8}, {64, 0}};
-    if (!sweepers::test::coarse()) sizes.push_back({128, 44});
-    for (const auto& [inverse, unexplained] : sizes) {
+    // The voxels checkLevelSet refuses off the features the report names, as measured: for a
+    // centre on the surface and for one 2 voxels in (where the junction of the ball and the
+    // pushed surface bends within a few voxels). Before the ball was filled for centres that
+    // deep, the second left 208 at 1/32 and 1244 at 1/64 on the ball's cap.
+    struct Size {
+        int inverse;
+        std::size_t onSurface, inside;
+    };
+    std::vector<Size> sizes = {{32, 8, 24}, {64, 0, 88}};
+    if (!sweepers::test::coarse()) sizes.push_back({128, 44, 208});
+    for (const auto& [inverse, onSurface, inside] : sizes) {
         const double h = 1.0 / inverse;
-        for (const double out : {0.0, 1.5 * h}) {
+        // On the surface, 1.5 voxels out (moved onto it) and 2 voxels in (within the band).
+        for (const double out : {0.0, 1.5 * h, -2.0 * h}) {
+            const std::size_t unexplained = out < 0.0 ? inside : onSurface;
             Sculptor s(makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3));
             const double v0 = levelSetVolume(s.grid());
             InflateStroke inflate{Eigen::Vector3d(0, 1.0 + out, 0), rho};
@@ -711,11 +721,16 @@ TEST(Advect, AnInflationCentredOnTheSurfaceAddsOneBallOfClay) {
             const BandReport band = checkBand(s.grid());
             std::printf("[ inflate ] on the surface%s at 1/%d: %zu parts, Euler %d, volume "
                         "%+.5f (ball %.5f), checkLevelSet refuses %zu, %zu on features\n",
-                        out > 0 ? " (1.5 voxels out)" : "", inverse, m.components,
-                        m.eulerCharacteristic, m.volume - v0, ball, peer.eikonal, peer.eikonalThin);
+                        out > 0   ? " (1.5 voxels out)"
+                        : out < 0 ? " (2 voxels in)"
+                                  : "",
+                        inverse, m.components, m.eulerCharacteristic, m.volume - v0, ball,
+                        peer.eikonal, peer.eikonalThin);
             EXPECT_EQ(m.components, 1u) << inverse;
             EXPECT_EQ(m.eulerCharacteristic, 2) << inverse;
-            EXPECT_NEAR(m.volume - v0, ball, 0.02 * ball) << inverse;
+            // The ball 2 voxels in comes out short by what the flare where the pushed surface
+            // leaves it loses at the grid's resolution (2.3% at 1/32, 0.9% at 1/128).
+            EXPECT_NEAR(m.volume - v0, ball, (out < 0.0 ? 0.03 : 0.02) * ball) << inverse;
             EXPECT_EQ(band.vdbCheck, "") << inverse;
             EXPECT_EQ(band.bandHoles, 0u) << inverse;
             EXPECT_LE(peer.eikonal - peer.eikonalThin, unexplained) << inverse;
