@@ -69,7 +69,7 @@ class GestureGenerator {
         key(out, modeKey());
         if (chance(0.2)) key(out, 'M'); // the next mirror plane
         if (chance(0.3)) key(out, chance(0.5) ? '[' : ']', false, chance(0.4)); // shift: falloff
-        if (chance(0.3)) key(out, chance(0.5) ? GLFW_KEY_LEFT : GLFW_KEY_UP); // turn the view
+        if (chance(0.3)) key(out, chance(0.5) ? GLFW_KEY_LEFT : GLFW_KEY_UP);   // turn the view
         // A press mostly on the shape (the view frames it: about a third of the window's
         // height across), at times beside it.
         const double cx = 0.5 * o_.width, cy = 0.5 * o_.height;
@@ -81,7 +81,7 @@ class GestureGenerator {
         press.type = InputEvent::Type::Press;
         press.x = x;
         press.y = y;
-        press.shift = chance(0.15); // smooth, whatever the tool
+        press.shift = chance(0.15);                // smooth, whatever the tool
         press.ctrl = !press.shift && chance(0.15); // the tool inverted
         out.push_back(press);
         const int moves = integer(1, o_.mostMoves);

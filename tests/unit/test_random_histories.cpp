@@ -22,6 +22,7 @@
 #include <tbb/task_arena.h>
 
 #include "app/document.h"
+#include "app/sculpt_controller.h"
 #include "app/session.h"
 #include "coarse.h"
 #include "grids.h"
@@ -32,6 +33,9 @@
 #include "levelset/create.h"
 #include "levelset/measure.h"
 #include "levelset/peer_check.h"
+#include "mesh/marching_cubes.h"
+#include "mesh/triangle_mesh.h"
+#include "random_gestures.h"
 #include "random_history.h"
 #include "replay.h"
 #include "scratch_dir.h"
@@ -47,8 +51,11 @@ std::size_t envCount(const char* name, std::size_t fallback) {
 }
 
 // The properties, in the order they are checked.
-const std::vector<std::string> kProperties = {"valid",    "runs",    "undo", "redo",   "band",
-                                              "topology", "threads", "peer", "journal"};
+const std::vector<std::string> kProperties = {"valid",    "runs",   "undo",    "redo", "band",
+                                              "topology", "volume", "threads", "peer", "journal"};
+// The most a volume-keeping stroke (swirl, fluid) may change the volume by, in voxel layers
+// over the surface a segment (docs/stroke-scripts.md).
+constexpr double kVolumeLayers = 0.03;
 
 struct Failure {
     std::string property, detail;
@@ -94,7 +101,7 @@ class HistoryCheck {
             const GridPtr before = doc.grid().deepCopy();
             const int eulerBefore = topologicalEulerCharacteristic(doc.grid());
             doc.beginEdit();
-            doc.applyStroke(stroke);
+            const SegmentReport last = doc.applyStroke(stroke);
             doc.endEdit();
             const GridPtr after = doc.grid().deepCopy();
             doc.undo();
@@ -107,6 +114,19 @@ class HistoryCheck {
             if (!band.vdbCheck.empty() || band.bandHoles || band.beyondBand)
                 fail("band", at(i) + band.vdbCheck + " holes " + std::to_string(band.bandHoles) +
                                  " beyond " + std::to_string(band.beyondBand));
+            if (keepsVolume(stroke)) {
+                // In voxel layers over the surface, per segment: what resampling may shave off
+                // or add at each step.
+                const TriangleMesh a = meshLevelSet(*before), b = meshLevelSet(doc.grid());
+                const double h = doc.grid().voxelSize()[0], area = surfaceArea(a);
+                const double layers =
+                    (enclosedVolume(b) - enclosedVolume(a)) / (h * area) / double(last.segment + 1);
+                std::printf("[ volume ] %s: %+.3g voxel layers a segment (%zu segments)\n",
+                            history_["strokes"][i].dump().c_str(), layers, last.segment + 1);
+                if (std::abs(layers) > kVolumeLayers)
+                    fail("volume", at(i) + std::to_string(layers) +
+                                       " voxel layers over the surface a segment");
+            }
             const int euler = topologicalEulerCharacteristic(doc.grid());
             if (euler != eulerBefore && !changesTopology(stroke))
                 fail("topology", at(i) + "Euler characteristic " + std::to_string(eulerBefore) +
@@ -150,6 +170,9 @@ class HistoryCheck {
         failures_.push_back({property, detail});
     }
     static std::string at(std::size_t stroke) { return "stroke " + std::to_string(stroke) + ": "; }
+    static bool keepsVolume(const Stroke& s) {
+        return std::holds_alternative<SwirlStroke>(s) || std::holds_alternative<FluidStroke>(s);
+    }
     // The strokes that change the topology on purpose (a flow's field is not a sweeper).
     static bool changesTopology(const Stroke& s) {
         return std::holds_alternative<PinchStroke>(s) ||
@@ -330,4 +353,59 @@ TEST(FixedHistories, HoldWhatTheyOnceBroke) {
                 << name << " breaks " << f.property << ": " << f.detail;
     }
     EXPECT_GT(n, 0u);
+}
+
+// The modeler's hands on random input (random_gestures.h): whatever the drags, keys, undos and
+// cancels, the script the modeler records applies, as `sweepers-cli apply` applies it, to the
+// grid the modeler shows, to the bit; every stroke undone gives back the start, and redone, the
+// same grid again. A failing case is written out as its events (replayable in the window with
+// --replay-input) and the script it recorded. By hand: SWEEPERS_GESTURE_HISTORIES=N.
+TEST(RandomGestures, TheRecordedScriptIsWhatTheModelerSculpted) {
+    const std::size_t count = envCount("SWEEPERS_GESTURE_HISTORIES", test::coarse() ? 6 : 12);
+    const unsigned seed = unsigned(envCount("SWEEPERS_HISTORY_SEED", 1));
+    const char* out = std::getenv("SWEEPERS_HISTORY_OUT");
+    std::size_t strokes = 0;
+    for (std::size_t i = 0; i < count; ++i) {
+        const unsigned s = seed + unsigned(i);
+        const InputReplay replay = test::GestureGenerator(s).replay();
+        Document doc(Document::sphereScript(1.0 / 32), ".");
+        const GridPtr start = doc.grid().deepCopy();
+        SculptController ctl(/*waitEachPiece=*/true);
+        ctl.setViewport(replay.width, replay.height);
+        ctl.setDocument(&doc);
+        ctl.frameView();
+        replayEvents(ctl, replay.events);
+        doc.endEdit();
+        const std::string said = ctl.takeMessage();
+        std::vector<std::string> failures;
+        const StrokeScript recorded =
+            parseStrokeScript(formatStrokeScript(doc.script()), "recorded gestures");
+        if (const std::size_t d = test::differingBits(*applyScript(recorded, "."), doc.grid()))
+            failures.push_back("the recorded script applies to a grid " + std::to_string(d) +
+                               " voxels off");
+        const GridPtr sculpted = doc.grid().deepCopy();
+        std::size_t undone = 0;
+        for (; doc.canUndo(); ++undone)
+            doc.undo();
+        if (const std::size_t d = test::differingBits(doc.grid(), *start))
+            failures.push_back("undone: " + std::to_string(d) + " voxels off the start");
+        for (std::size_t k = 0; k < undone; ++k)
+            doc.redo();
+        if (const std::size_t d = test::differingBits(doc.grid(), *sculpted))
+            failures.push_back("redone: " + std::to_string(d) + " voxels off");
+        strokes += recorded.strokes.size();
+        std::printf("[ gestures ] seed %u: %zu events, %zu strokes recorded%s%s%s\n", s,
+                    replay.events.size(), recorded.strokes.size(),
+                    said.empty() ? "" : " (said: ", said.c_str(), said.empty() ? "" : ")");
+        if (failures.empty()) continue;
+        const std::string stem =
+            std::string(out && *out ? out : ".") + "/gestures_" + std::to_string(s);
+        std::ofstream(stem + "_events.json") << test::replayJson(replay).dump(1) << '\n';
+        std::ofstream(stem + "_recorded.json") << formatStrokeScript(doc.script());
+        for (const std::string& f : failures)
+            ADD_FAILURE() << "gesture seed " << s << ": " << f << " (written to " << stem
+                          << "_*.json)";
+    }
+    // The input must sculpt: most gestures press on the shape.
+    EXPECT_GT(strokes, count);
 }
