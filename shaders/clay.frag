@@ -1,4 +1,5 @@
 #version 330 core
+// SPDX-License-Identifier: Apache-2.0
 // The surface's looks. Clay (look 0): a matte clay lit in the view, a warm key light from
 // the upper left of the camera, a cool fill from below, a soft rim, and a little wrap so
 // the terminator stays gentle. The others are matcaps: a colour for each direction the

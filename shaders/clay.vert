@@ -1,4 +1,5 @@
 #version 330 core
+// SPDX-License-Identifier: Apache-2.0
 // Clay surface: positions and SDF-gradient normals in world space, shaded in view space.
 layout(location = 0) in vec3 position;
 layout(location = 1) in vec3 normal;

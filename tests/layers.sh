@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The layers of src/ only depend downwards:
 #   core < tools < deform < levelset < mesh < sculpt < study < io < app, cli < python
 # A file may include headers of its own layer and of layers below it; app and cli do not

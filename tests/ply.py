@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """A reader of the binary PLY meshes sweepers-cli writes, for the tests: independent of
 the project's own reader, and strict about what it expects."""
 import struct

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // An orbit camera: yaw and pitch about a target, at a distance; perspective projection.
 #pragma once
 

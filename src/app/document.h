@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The modeler's document: a level set, its mesh kept up to date leaf by leaf, every edit
 // recorded as a stroke script (which `sweepers-cli apply` replays to the same grid), and
 // undo / redo that keep only the blocks a stroke touched. No GL here. Every segment goes

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #define GL_GLEXT_PROTOTYPES
 #include "app/gl_renderer.h"
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Draws a document with OpenGL 3.3 core: the clay surface in bricks of 4^3 leaves (only
 // bricks whose chunks changed are re-uploaded), an optional wireframe, the ground grid,
 // the tool with its coating as translucent shells, and the lines of a stroke's preview.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Recorded mouse and keyboard events, replayed frame by frame into the real window's
 // handlers, so tests drive the modeler exactly as a user would.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // sweepers: the interactive modeler.
 #include <algorithm>
 #include <cstdio>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The interactive modeler: a GLFW window over a Document, sculpted with the mouse.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The modeler's input logic without a window: mouse, key and wheel events in (window
 // pixels, origin top left), camera moves and sculpting out. A drag on the shape becomes
 // tool placements, and each piece of sculpting (a sweep segment, a swirl ring, a dab of

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Keeps the modeler's work safe against a crash (io/session_journal.h has the files): every
 // completed edit is appended to the session's journal, and every few strokes a checkpoint of
 // the grid is saved beside it. A thread of the session's own does all the writing, in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The modeler's timeline: the document's history played as a film (sculpt/film.h) on a
 // grid of its own, scrubbed, played, paused and sped up, while the document waits as it
 // was. Frames are made on a worker thread so the window keeps drawing; the window shows

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Other programs run by sweepers-cli: this program itself for the runs of a study run side
 // by side (study --jobs), and Slurm's commands (study --slurm).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the commands of sweepers-cli share: their exit codes, usage errors, the output
 // options every command takes, and the flag that Ctrl-C and SIGTERM raise.
 #pragma once

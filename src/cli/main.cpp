@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // sweepers-cli: the command-line front end. Every failure prints one line on stderr,
 // exits non-zero and leaves no output file behind. The exit codes (docs/cli.md): 0 done,
 // 1 input refused or the work failed, 2 a usage error, 3 a study that finished with runs

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // How sweepers-cli shows the progress of long work on stderr, so that it reads well
 // wherever stderr goes:
 //  - on a terminal, one line redrawn in place: a bar, the count, the rate and the time left;

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A study's runs submitted to Slurm (study --slurm): a job array per voxel size, coarsest
 // first and each after the one before, so that at most --max-running runs run at once and
 // each array asks for its own runs' memory and time; and a merge job after them all.

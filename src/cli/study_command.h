@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // sweepers-cli study: a grid-resolution study planned as independent runs
 // (io/study_plan.h), run here one after another or several at once (--jobs), or submitted
 // to Slurm (--slurm), and merged into one table, report and set of plots.

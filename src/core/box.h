@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Axis-aligned box in world units. Empty until something is added to it.
 #pragma once
 

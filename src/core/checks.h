@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Checks of the numbers a script or a caller gives, shared by every layer.
 #pragma once
 

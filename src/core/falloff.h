@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Falloff functions that turn a distance into an amount of deformation.
 //
 //   mu(d, lambda)     C2 piecewise quintic with support [0, lambda)   (thesis 3.2)

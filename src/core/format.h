@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Numbers in messages, as a user reads them: "0.015625", "1e+308", "36.2 GB", "2.1e+25 TB"
 // (never the 300 digits std::to_string gives a large double).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What one piece of work may ask for, checked against its estimate before it starts
 // (docs/cli.md, "Limits"): the memory a start shape or a run may take, and the work of one
 // stroke's deformation or smoothing dab, counted in voxel updates (a voxel's value computed

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // How much memory the machine has free for a new job, how much this process used, and how
 // the process keeps what it frees.
 #pragma once

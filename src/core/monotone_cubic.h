@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Monotone, mostly C1 cubic interpolation (thesis appendix C.1): a Hermite cubic whose end
 // slopes, central differences, are clamped to [Delta/2, 3 Delta] (or set to 0) so the
 // interpolant never leaves the range of the two samples it lies between. Convecting or

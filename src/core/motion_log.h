@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // MotionLog: the logarithm of an affine motion of space, the quantity that sweepers blend
 // (3.5, 3.17). It is a 4x4 matrix with a zero last row, stored as its linear block and
 // translation column, together with the narrowest family it belongs to, so that the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Wall-clock timing of the engine's stages and the modeler's frames.
 #pragma once
 

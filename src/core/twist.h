@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Twist (the thesis's "hexanion", chapter 7): the logarithm of a rigid motion as a pair of
 // vectors <omega, m>. omega is the rotation axis scaled by the angle, m the translation
 // column of the log matrix (7.3). Twists form a real vector space, so fractions and

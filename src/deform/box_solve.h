@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Exact solves of (shift - scale Laplacian) x = b on a box of cells, the 7-point Laplacian
 // with each axis's ends either closed (no flow through them: Neumann) or held at zero
 // (Dirichlet, the value beyond the end being zero). The swept fluid's implicit diffusion

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The discontinuous scalar fields of the topology tools (thesis 3.39, 3.40, 3.43, 3.44):
 // phi = alpha rho, where alpha is a cone-like field of the angle a between p - apex and an
 // axis (1 within a_in of the axis, 0 beyond a_out) and rho a sphere-like field of a distance

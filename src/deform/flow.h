@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Deformations given by a velocity field (velocity_field.h): a flow from time t0 to t1 is
 // applied in segments, each one resample of the grid, and each segment composes the inverse
 // of its sub-steps before that one sample, as every deformation of the engine does. A

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Decaudin's inflation (thesis 2.30, 2.31, after [Dec96]) and the star-shaped
 // swirling-sweepers built on it (4.16-4.19).
 //

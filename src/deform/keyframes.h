@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Placements keyed over time (thesis 3.6.1: a keyframed tool's target, a sliding
 // deformation's local frame), interpolated by a Catmull-Rom spline with non-uniform times
 // (Hermite segments whose tangents are the central differences of the neighbouring keys,

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The pinch tool (thesis 3.5.1): two needles on a line through `at` along `axis` whose tips
 // start at at +- size axis and meet at `at`, each weighting a translation along the line by
 // its discontinuous field (3.39, 3.40: a cone around the needle's body, bounded by a ball

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A tool placement along a path: translation t, optional rotation (axis, angle in degrees)
 // and scale (uniform or per local axis). As a world-from-local matrix it is T(t) R S.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Velocities given on a lattice (a vector grid read from a VDB file by io/, or the
 // swept-fluid solver's result, swept_fluid.h) made a field defined everywhere by the
 // trivariate uniform cubic B-spline of appendix C (thesis 4.2.2, "Smoothing the solution"):

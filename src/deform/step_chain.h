@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Deformations applied one after another as one: their sub-steps in order, composed before a
 // single resample of the grid. A swept-fluid segment (swept_fluid.h) chains the flow steps
 // of the tool's successive positions this way.

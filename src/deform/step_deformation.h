@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The common shape of every deformation the engine applies: s sub-steps, each defined by
 // the closed form of its inverse, p -> exp(-L_k(p)) . p (thesis 5.18, 5.19), with a box
 // outside which all of them are the identity. Sweeps (sweep.h) and swirl rings (swirl.h)

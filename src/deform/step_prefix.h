@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The first m sub-steps of a deformation: the part of its motion done by a fraction m / s
 // of the way (animated modeling, thesis 3.6.2: the partial motion stands in for the
 // segment's end placement, 3.48). A sweep segment's sub-steps follow its motion, so the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The strangle tool (thesis 3.5.2): a circle of radius `size` in the plane through `at`
 // normal to `axis` contracts onto its centre, weighting a scale of the plane's directions
 // about the axis by a field discontinuous on the disc it spans (3.43-3.45: a cone around

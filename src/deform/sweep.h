@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sweeps: one or several tools moved together along a path of placements, optionally
 // mirrored about a coordinate plane (thesis chapter 3, 5.3.3).
 //

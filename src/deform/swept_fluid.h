@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Swept fluid (thesis 4.2): the flow of an incompressible fluid around a ball, solved once
 // and swept along the tool's path, a second volume-preserving grab.
 //

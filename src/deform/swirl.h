@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Swirling-sweepers (thesis 4.1): volume-preserving pulls. The user gives a point h and a
 // move t; a ring of n swirls of radius r, in the plane through h perpendicular to t, is
 // swept along t in s = max(1, ceil(4|t|/r)) sub-steps (4.3).

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The pulling half of the topology tools (thesis 3.41, 3.42): space is pushed away from a
 // convex set S (the segment between the pinch's needle tips before pinching, or the disc the
 // strangle's circle spanned), each point along the direction from its nearest point q on S:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "deform/velocity_field.h"
 
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Velocity fields v(x, t): deformations given by a flow (thesis chapter 4), whose
 // characteristics the flow steps of flow.h integrate. Each field is zero outside a box and
 // Lipschitz in x with a known bound, which bounds the integration steps.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Atomic saves: the content is written to a temporary file next to the target, flushed to
 // disk and renamed over the target, so a crash, a full disk or any other error never
 // leaves a half-written file and never destroys the previous version.

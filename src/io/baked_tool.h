@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Baked tools of stroke scripts (thesis 3.4.3): the level set or closed mesh a tool names,
 // read and turned into a tool once. Tools are shared through a cache keyed by the file
 // (and its modification time), the grid, the sampling and the band, so a study at several

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The files of a film (sweepers-cli animate, sculpt/film.h): one VDB per frame, named by a
 // pattern whose run of '#' is the frame number padded with zeros to its length
 // (NAME_####.vdb: Blender's default for volume sequences), each holding the level set

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The swept-fluid solution (deform/swept_fluid.h) is solved once per machine: the first run
 // that needs it solves it (a noticeable wait at 72^3 cells) and keeps it as a VDB file in the cache
 // directory, $SWEEPERS_CACHE, else $XDG_CACHE_HOME/sweepers, else ~/.cache/sweepers; later

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Files a user names, checked before they are opened: a FIFO, a device or a directory in a
 // file's place is refused at once (opening a FIFO waits for a writer that never comes;
 // /dev/zero never ends), and text files are read only up to a bound (docs/files.md).

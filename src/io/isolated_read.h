@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Reading level-set and velocity files we did not write in a child process. OpenVDB's reader can
 // crash, loop or allocate without bound on a damaged file; in a child with a time and a
 // memory limit the worst it can do is end that child, and the caller gets a FileError in

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Triangle mesh files through Assimp: OBJ, PLY and binary STL out, and whatever Assimp
 // reads in (OBJ, PLY, STL, ...). The format follows the file extension.
 #pragma once

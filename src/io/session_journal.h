@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A modeler session on disk, so that a crash loses no completed stroke. A session is a
 // directory holding
 //   lock                 held (flock) by the running modeler: a free lock means its owner died

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The start shape of a stroke script as a level set: a sphere, or the .vdb or mesh file
 // the script names (relative to the script's directory).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Stroke scripts: the JSON file format of the stroke model (sculpt/stroke.h);
 // docs/stroke-scripts.md documents every field.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The files of a grid-resolution study: DIR/study.csv (one row per run, the columns below),
 // DIR/report.md (the tables and the observed orders, for reading at a glance) and the
 // convergence plots; each run's row is also kept as JSON in its result file

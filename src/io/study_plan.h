@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A grid-resolution study as a plan of independent runs: one per script x voxel size x
 // variant, each run one command that any machine sharing the study's directory can run
 // (docs/studies.md). The plan (DIR/plan.json) names every run, what its result depends on

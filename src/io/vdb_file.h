@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // VDB files (docs/files.md): one FloatGrid named "surface", class level
 // set, linear transform with the voxel size, background = half-width x voxel size,
 // negative inside, metadata creator / voxel_size / half_width. Reading accepts any float

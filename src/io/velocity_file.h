@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Velocity fields in VDB files: a grid of float vectors (vec3s, OpenVDB's Vec3SGrid) with
 // cubic voxels aligned with the axes, velocities in world units per unit of time, cell-centred
 // or staggered (grid class "staggered": the x component of voxel (i, j, k) lies on its face at

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "levelset/advect.h"
 #include "core/stopwatch.h"
 #include "levelset/band.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Semi-Lagrangian advection of a level set through one deformation (thesis 5.3.3): a
 // sweep segment, a swirl ring, an inflation.
 //

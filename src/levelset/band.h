@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Measuring a level set as a narrow band: where it crosses zero, how much of it is a true
 // distance, and the box it covers.
 #pragma once

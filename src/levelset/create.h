@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Making narrow-band level sets: the document's lattice, spheres, closed meshes, and the
 // metadata every grid Sweepers writes carries.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The voxel sets of a segment's work, listed leaf by leaf (VoxelList): dilation by a cube,
 // and what turns a tree into such a list and a list into a tree.
 //

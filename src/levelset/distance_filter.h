@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The Gaussian of a narrow band's signed distance near its surface, at a cost that follows
 // the band, not the Gaussian's volume.
 //

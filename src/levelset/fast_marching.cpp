@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 #include "levelset/fast_marching.h"
 #include "levelset/parallel.h"
 

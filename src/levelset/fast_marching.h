@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Renormalization of a narrow-band level set (thesis 5.3.3, [Bae01]): after a deformation
 // the values near the surface still locate it, but are no longer distances. The discrete
 // equations of fast marching rebuild |grad phi| = 1 outward from the surface:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Cancelling long work: an interrupter in OpenVDB's style (util::NullInterrupter), polled
 // by the engine once per leaf range or batch of voxels. When it says stop, the operation
 // throws Cancelled; the caller puts back what it had (a document restores its snapshot, a

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A box of leaves, every slot holding the index of a leaf in a list (or a mark) or -1: a
 // leaf's neighbour is an array read, not a search or a hash lookup. Positions are in leaves
 // (origin / 8). The mask dilation and the renormalization's domain find neighbouring leaves

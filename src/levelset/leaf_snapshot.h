@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A copy of parts of a level set, 8^3 block by block, that can be put back exactly: what
 // undo keeps for a stroke (only the blocks its segments could touch, each once).
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A leaf's voxel sets as eight 64-bit words, one per x: bit y * 8 + z of word x is the voxel
 // at offset x * 64 + y * 8 + z (the layout of a leaf's value mask). The scans of the band
 // (voxels next to the surface, seeds, thin features) test 64 voxels at a time by moving a

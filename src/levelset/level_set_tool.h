@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Baked tools (thesis 3.4.3): any closed shape, given as a level set, used as a sculpting
 // tool with the same falloff, sub-step bound and blending as a ball.
 //

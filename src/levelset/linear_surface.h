@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The surface a grid's values place between voxels, read linearly: the zero set of the
 // piecewise-linear interpolation of the values on Kuhn tetrahedra (each cube split into six
 // along its main diagonal, the same way in every cube, so the pieces meet without gaps). Its

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Work on the part of a tree inside an index box, at a cost that follows the box, not the
 // tree: a sculpting segment touches a brush-sized box of a model that only grows.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What `sweepers-cli info` reports about a level set.
 #pragma once
 

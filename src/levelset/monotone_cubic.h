@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The monotone cubic of appendix C.1 (core/monotone_cubic.h) on a grid: tricubic, and so
 // sharper than trilinear, without overshoot.
 #pragma once

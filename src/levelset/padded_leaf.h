@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A leaf's values and the layer of voxels around it (10 x 10 x 10, x slowest): stencils that
 // read a voxel's neighbours read this block instead of the tree. The 26 leaves around are
 // found once (their buffers, or the one value of a tile or of empty space) and read directly.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The engine's parallel loops, and how much of a piece of work runs on one thread.
 //
 // Amdahl's law bounds what more cores can give by the share of the work that runs on one

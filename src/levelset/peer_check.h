@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What OpenVDB's own diagnostics (tools::checkLevelSet, which Houdini's VDB Diagnostics and
 // vdb_tool apply too) say of a level set, and how much of their eikonal complaint sits on
 // features thinner than their stencil reads.

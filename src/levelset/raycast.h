@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Where a ray first meets the surface of a level set (what the modeler grabs), and where
 // it leaves the shape again (the far side a pinch goes through).
 #pragma once

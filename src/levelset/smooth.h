@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Smoothing under a brush: the level sets relax by mean-curvature flow,
 //     d phi / dt = w(x) kappa |grad phi|,   kappa = div(grad phi / |grad phi|),
 // for a flow time t, weighted by the brush's falloff w (1 inside the ball, mu of 3.2 across

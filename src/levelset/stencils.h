@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Small pieces of index arithmetic on the voxel lattice, written once: rounding down to a
 // block, the corners of a voxel cube, the central-difference gradient.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The upwind update of renormalization for a row of eight voxels at once (eight lanes of
 // vector registers): a row of a dense block of one side's distances (along the block's axis
 // of stride 1), where the other side's voxels read as +infinity.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // OpenVDB types the engine uses, and conversions to and from the Eigen types of the math
 // core. Everything from levelset/ up includes this instead of OpenVDB directly.
 #pragma once

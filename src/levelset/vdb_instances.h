@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The OpenVDB grid classes the program uses, instantiated once (vdb_*_instances.cpp) instead
 // of in every source file that makes or copies a grid. Tree and Grid are class templates with
 // virtual members: a source that constructed one instantiated, optimized and compiled every

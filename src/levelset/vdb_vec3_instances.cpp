@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The one instantiation of the Vec3STree grid classes declared extern in vdb_instances.h (a
 // source file per grid type, so that they compile in parallel).
 #include "levelset/vdb_instances.h"

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A voxel set listed leaf by leaf: each leaf's origin and its voxels as words (leafwords). A
 // leaf may be listed more than once: its voxels are those of all its entries. A segment's
 // working sets are kept so, where they are only read a leaf at a time: as trees, each of

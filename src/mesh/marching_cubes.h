@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Marching cubes over a narrow-band level set, kept in chunks of one VDB leaf each, so a
 // stroke re-meshes only the leaves it touched (plus one ring of neighbours).
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Marching-cubes case table with a preferred polarity (thesis 5.3.1), generated from the
 // 256 corner configurations instead of typed in, so that it cannot hold a hole.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // An indexed triangle mesh and the checks an exported surface must pass.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // `import sweepers`: the engine for Python notebooks (docs/python.md). The work is done by
 // python/shape.h and the io layer; this file turns Python's values into the engine's and
 // back, releases the GIL around engine work, turns Ctrl-C (SIGINT) into the engine's

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // What the Python module (module.cpp) shows, without Python: a sculpted shape with the
 // history that made it, and a sculpting session with undo (the modeler's Document without
 // a window). Errors are the engine's own exceptions; the bindings turn them into Python's.

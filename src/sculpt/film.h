@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Animated modeling (thesis 3.6.1, the third technique, and 3.6.2): a stroke script played
 // over time, so that a film shows each stroke happening. A stroke lasts its `duration`, or
 // else `secondsPerSegment` times its path segments (one for a stroke without a path); its

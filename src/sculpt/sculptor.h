@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The one stroke path: a Sculptor owns a level set, the mesh kept up to date with it, and
 // the undo record of the edit in progress, and applies strokes to them segment by segment.
 // The command line (applyStrokes) and the modeler's document both go through

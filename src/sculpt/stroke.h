@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The stroke model: what a sculptor does to a shape, as data. A stroke script (io/) and
 // the modeler's drags (app/) both produce these; planStroke is the one place where a
 // stroke kind becomes deformations.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The exact shape a stroke history defines, known without any grid (the idea of thesis
 // 5.4): every sub-step is given by the closed form of its inverse (5.18, 5.19), so a point x
 // lies inside the sculpted shape exactly when the start shape contains

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Grid-resolution studies: one stroke script applied at a voxel size with a numerical
 // variant, measured against the exact reference of the same history (reference.h): how far
 // the result's surface lies from the true one, how many voxels are on the wrong side, the

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Ball and filled-ellipsoid tools.
 //
 // Both are the unit ball scaled by semi-axes in the local frame. Under a placement the

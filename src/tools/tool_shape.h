@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The interface every tool shape implements, and the tool (shape + falloff) built on it.
 //
 // A shape is defined in its own local frame; a placement (an affine world-from-local map,

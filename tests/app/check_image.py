@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Pixel checks on the modeler's screenshots (Pillow).
 
   check_image.py centred SHOT            the clay object sits in the middle of the frame

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # What every test script of the windowed modeler starts with; sourced as
 # `. common.sh "$@"`: app (sweepers) and cli (sweepers-cli) from the arguments, here (this
 # directory), the Python that has pyopenvdb and Pillow, a temporary directory removed on

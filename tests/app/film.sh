@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The modeler's timeline in a real window (run under xvfb-run with Mesa): a replayed drag,
 # its history opened as a film (V) and stepped with the keys to its middle frame, which is
 # saved and measured; the film recorded as PNGs; a directory for them that cannot be made.

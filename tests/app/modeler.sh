@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The modeler in a real window (run under xvfb-run with Mesa): screenshots read back as
 # pixels, replayed mouse and keyboard input, undo / redo, the recorded script replayed by
 # sweepers-cli, and bad files opened in the window.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Replays a modeler input file through the sculpt controller with no window, as
 // `sweepers --size WxH --replay-input EVENTS --save-script OUT` does with one, and writes
 // the recorded stroke script (the test compares the two, byte for byte).

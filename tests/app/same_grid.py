@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """same_grid.py A.vdb B.vdb: the two level sets hold the same voxels (values and states)."""
 import sys
 import pyopenvdb as vdb

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Stroke advection: one sweep segment of a ball tool against tools::LevelSetAdvection
 // given the same motion as a velocity field.
 //

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Shared pieces of sweepers-bench: the voxel sizes to run, analytic shapes, and the
 // figures the benchmarks compare (distance errors, symmetric differences, meshes).
 #pragma once

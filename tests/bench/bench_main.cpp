@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // sweepers-bench: our engine against the OpenVDB tools a user would otherwise reach for,
 // timed in the same process on the same grids. Google Benchmark runs and times each case;
 // this file adds what it lacks: the speed-up of each of our methods over the OpenVDB

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The brushes group: every kind of stroke with the same ball (radius 0.25 on the unit
 // sphere) at voxel sizes 1/64, 1/128 and 1/256 (r/h = 16, 32, 64), and 1/512 for the sweep
 // and the smooth dab: the per-segment (or per-dab) p50 and p95 of the engine's time (no

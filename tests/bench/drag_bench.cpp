@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The interactive budget: data/drag.json, a recorded drag of 100 short segments with a
 // ball tool of radius 0.25 on the unit sphere, replayed as the modeler does it (advect,
 // renormalize, re-mesh the touched leaves after every segment), at every size of the run

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Enright's 3D deformation test (Enright, Fedkiw, Ferziger and Mitchell 2002): the sphere of
 // radius 0.15 at (0.35, 0.35, 0.35) in the unit box, carried by the periodic field of period
 // 3 to t = 1.5 (the thinnest sheet) and to t = 3 (back where it began). Ours (a flow stroke:

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Meshing: our marching cubes (every leaf, welded into one mesh, as for export) against
 // tools::volumeToMesh (dual contouring without adaptivity), on the same grids.
 #include "bench.h"

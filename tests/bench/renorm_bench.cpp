@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Renormalization: our fast marching (first and second order) against tools::sdfToSdf
 // (fast sweeping) and tools::LevelSetTracker::normalize, all with their defaults.
 //

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # sweepers-cli animate: a script played as a film, one VDB per frame (and a mesh and a fog
 # volume when asked), read back by vdb_print and python3-openvdb; the ends of the film
 # against the start and `apply`; resuming; Ctrl-C; and every refusal with its message.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # sweepers-cli check on real scripts: a valid one prints its plan, a bad one fails with one
 # line on stderr that names the file, the location and the reason.
 . "$(dirname "$0")/common.sh" "$@"

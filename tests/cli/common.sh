@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # What every command-line test script starts with; sourced as `. common.sh "$@"`:
 # cli (the sweepers-cli to test) and data (the data/ directory) from the arguments, the
 # Python that has pyopenvdb, a temporary directory removed on exit, fail, and refuses.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # sweepers-cli end to end: real scripts in, VDB and meshes out, read back by independent
 # readers (vdb_print from libopenvdb-tools, pyopenvdb under Debian's python3); every
 # failure path exits non-zero with one line on stderr and leaves no output file.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The swept fluid and sampled velocity fields from the command line: the solution kept in
 # the cache directory as a VDB that independent readers see as a staggered vec3s grid and
 # read back by the next run; a fluid grab against a sweep on the same

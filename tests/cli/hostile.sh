@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Input a hostile user gives (issue cases of "bad input never hurts"): what is not a regular
 # file in a file's place, a script without end, option values that make no sense, a film
 # without bound, and errors asked for as JSON. Each is refused at once, with one line that

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Files we did not write cannot take sweepers-cli down: broken meshes (indices out of
 # range or negative, non-finite or enormous coordinates, a header announcing 2^31
 # vertices, an open surface), level sets with non-finite values or no surface, files of

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """mutate.py SOURCE OUTDIR COUNT SEED: COUNT damaged copies of SOURCE, the same ones for the
 same seed: flipped bits, truncations, zeroed or random ranges, duplicated chunks, and
 numbers near the start (headers, counts, indices) replaced by extreme ones."""

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # What sweepers-cli prints, as scripts and pipes see it: progress as whole lines in a pipe
 # and as one line redrawn on a terminal, -q silent but for errors, --json one object on
 # stdout with the documented keys, and every documented exit code (docs/cli.md).

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # sweepers-cli recover on session journals written here by hand, as a modeler that died
 # would leave them: the history they hold (undo included) rebuilt to the grid that
 # `apply` makes of the same strokes; a record cut short by the crash or a damaged one; and

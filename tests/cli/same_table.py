@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """Two study tables (study.csv) hold the same runs and results: every column but those
 that say how long a run took, how much memory it used and where it ran."""
 import csv

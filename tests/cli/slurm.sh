@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # sweepers-cli study --slurm on a real one-node Slurm cluster started for this test and
 # stopped after it (tests/cli/slurm_cluster.sh): its table equals the local run's, a failed
 # run is named and the others merged, a task cancelled mid-run leaves no partial result and

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 # A one-node Slurm cluster for a test, sourced: start_cluster starts munged, slurmctld and
 # slurmd with their config, state, spool, pid and log files in a temporary directory of
 # their own (which the munge user can reach) and exports SLURM_CONF; stop_cluster stops

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # sweepers-cli study: a script replayed at several voxel sizes and variants and measured
 # against the exact shape its history defines. Checked here: the table's columns and rows,
 # the error of a translated sphere against the analytic sphere computed independently,

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # The same grid, voxel for voxel, whatever the number of threads: a drag, a swirl, a pinch
 # and a flow applied at 1, 2, 3 and 7 threads (7 oversubscribes a small machine on purpose,
 # so that the work is split and scheduled in other ways), compared with pyopenvdb.

@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # Writes never destroy good data: a full disk (a small tmpfs, where this user may mount
 # one, and a file-size limit, which needs nothing) makes apply, mesh and apply --mesh fail
 # with the reason, keep the old files as they were and leave no temporary file; a run

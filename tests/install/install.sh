@@ -1,4 +1,5 @@
 #!/usr/bin/env bash
+# SPDX-License-Identifier: Apache-2.0
 # What `cmake --install` and `cpack -G DEB` give a user: the programs, the shaders where the
 # installed modeler finds them, the examples and the guides, used from another directory;
 # and a Debian package holding them. Run under xvfb-run: install.sh BUILD_DIR
@@ -17,7 +18,7 @@ cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" || fail "$(cat "
 for f in bin/sweepers bin/sweepers-cli share/sweepers/shaders/clay.vert \
   share/sweepers/shaders/clay.frag share/sweepers/examples/drag.json \
   share/sweepers/examples/tools/finger.vdb share/doc/sweepers/README.md \
-  share/doc/sweepers/cli.md share/doc/sweepers/stroke-scripts.md; do
+  share/doc/sweepers/cli.md share/doc/sweepers/stroke-scripts.md share/doc/sweepers/LICENSE; do
   [ -e "$prefix/$f" ] || fail "cmake --install put no $f"
 done
 echo "installed: programs, shaders, examples and guides under $prefix"

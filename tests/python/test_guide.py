@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """docs/python.md's walk-through runs as written: its python blocks, one after another, from
 the source tree's root (where its data/ paths lead)."""
 import os

@@ -1,3 +1,4 @@
+# SPDX-License-Identifier: Apache-2.0
 """`import sweepers` from Debian's python3, checked against sweepers-cli and pyopenvdb.
 
 Run by CTest (python.module) with PYTHONPATH at the build's python/ directory and

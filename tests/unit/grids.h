@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Analytic level sets for the engine tests, built voxel by voxel from exact distances.
 #pragma once
 

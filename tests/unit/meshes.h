@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Comparing the meshes two SurfaceMeshers keep, chunk by chunk.
 #pragma once
 

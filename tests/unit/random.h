@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Seeded random geometry for property tests: every run sees the same cases.
 #pragma once
 

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Seeded random input for the modeler: what a user's hands do that nobody scripted. Drags in
 // every sculpt mode, on and off the shape, with Shift (smooth) and Ctrl (invert), the brush
 // resized and mirrored between them, the view turned, strokes undone and redone, and drags

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Seeded random stroke histories: scripts nobody wrote by hand, drawn from every stroke kind
 // and option a script accepts, placed near and across the surface of a start shape about a
 // unit across (a sphere, a level set read from a .vdb file, or a closed mesh), at voxel

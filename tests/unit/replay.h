@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A stroke script applied the way `sweepers-cli apply` applies it: its start grid, then
 // every stroke through a Sculptor.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // A fresh directory of its own for a test's files (mkdtemp), removed with everything in it
 // when the test ends: tests running at the same time never share a file name.
 #pragma once

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The modeler's window-free parts: the orbit camera, the input replay files and the
 // timeline.
 #include <cstdio>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Baked tools (3.4.3): a level set or a closed mesh as a sculpting tool.
 #include <cmath>
 #include <fstream>

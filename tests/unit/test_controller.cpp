@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The modeler's input logic without a window: drags become placements and strokes, fast
 // twists keep the hand's direction, and long work can be cancelled, leaving the document
 // and the mesh as they were.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The modeler's document without a window: strokes, undo / redo, the recorded script,
 // picking the surface, and the timeline that plays its history as a film.
 #include <gtest/gtest.h>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Animated modeling (sculpt/film.h): the film's timing, frames that show each stroke
 // happening, and the ends of the film against the start and against `apply`.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Deformations given by a velocity field (deform/flow.h): the fields, the flow steps' inverse
 // and forward maps, how many segments a flow takes, and flow strokes in scripts.
 #include <cmath>

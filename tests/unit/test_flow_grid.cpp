@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Flows on real grids (deform/flow.h through the one stroke path): a rigid rotation given as
 // a velocity field against the same rotation given as a sweep, and sampled in a VDB file;
 // Enright's deformation test, which stretches a sphere into a sheet and brings it back; and

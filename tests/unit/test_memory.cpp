@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The process's peak resident memory, and restarting its count for one piece of work.
 #include <cstdio>
 #include <cstring>

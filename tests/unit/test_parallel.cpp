@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // SerialClock: the time a piece of work spends on one thread while the others wait, counted
 // from what the parallel loops report. Only lower bounds of sleeps are asserted: a loaded
 // machine can make anything take longer, never shorter.

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // OpenVDB's own diagnostics on our grids, and the thin features that account for what its
 // gradient test refuses where a distance itself has no unit gradient.
 #include <gtest/gtest.h>

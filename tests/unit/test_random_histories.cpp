@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Histories nobody wrote by hand (random_history.h): every one must hold the properties a
 // history promises (docs/engine.md, "What a history guarantees"). A failing history is cut
 // to the fewest strokes that still fail and written out as a script, to become a fixed

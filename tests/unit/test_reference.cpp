@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The exact reference of a stroke history (study/reference.h): against analytic shapes for
 // rigid motions, and against the grid the engine sculpts for a real script.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The data scripts end to end on real grids: the heavy engine tests, labelled `slow`. Each
 // runs at the voxel size it names, or at twice it (eight times fewer voxels) when
 // SWEEPERS_COARSE_TESTS is set, as the sanitizer builds do.

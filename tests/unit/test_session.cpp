@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Crash-safe sessions: the journal's records, what reading makes of a journal cut short or
 // damaged, and a document rebuilt from a session that was never closed (as after a crash),
 // which must hold the very grid the document held.

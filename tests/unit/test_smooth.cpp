@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The smooth brush (levelset/smooth.h) on a bumpy sphere: the noise under the brush goes,
 // nothing beyond its reach moves, the stroke written to a script replays to the same grid,
 // and a study says no exact shape stands behind it.

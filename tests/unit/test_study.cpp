@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The pieces of a grid-resolution study that need no grid: variants, observed orders, and
 // a run's result as the table is made from it.
 #include <cmath>

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // Sampled velocity fields (deform/sampled_field.h) and the swept fluid (deform/swept_fluid.h):
 // the cubic B-spline's reproduction of linear fields and its Lipschitz bound, the solver's
 // divergence, the step count and modulation of 4.26 and 4.27, the segment's inverse and

@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The deformations of the topology tools (thesis 3.5): the tear (3.41, 3.42), the pinch's
 // needles (3.39, 3.40) and the strangle's noose (3.43-3.45), as maps of space.
 #include <cmath>

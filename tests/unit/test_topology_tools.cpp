@@ -1,3 +1,4 @@
+// SPDX-License-Identifier: Apache-2.0
 // The topology tools on real grids (thesis 3.5): a pinch makes a torus of a sphere, a
 // strangle parts a sphere, with the topology counted on the voxels and on the welded mesh
 // (the data scripts that sever a limb and cut a torus's tube are checked stroke by stroke in
