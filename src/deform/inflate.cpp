@@ -47,7 +47,7 @@ ForwardResult Inflation::forwardStep(int, const Eigen::Vector3d& q, double) cons
 
 bool Inflation::fillsWith(double fromValue) const {
     // Within the band the new surface lies less than a voxel beyond the ball's edge (s^3 /
-    // (3 rho^2) for a ball of a few voxels at least), closer than any sampled value says.
+    // (3 rho^2) for a ball of three voxels or more), closer than any sampled value says.
     // Deeper, the value at c is the band's and the surface lies farther out, where the
     // inverse samples distances again.
     return fills_ && fromValue > -fill_.band && fromValue < fill_.band;

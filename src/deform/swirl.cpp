@@ -71,13 +71,13 @@ std::optional<MotionLog> SwirlSegment::stepLog(int k, const Eigen::Vector3d& p) 
         const double a = d.squaredNorm() + l2 + r * r;
         const double b = 2.0 * l2 * l2 * r / std::pow(a * a - r * r * eta.squaredNorm(), 1.5);
         // The field is cut off at the bounding sphere through its stream function, not by
-        // itself: cut off by itself, it would pour clay through the sphere (the shape gains
-        // or loses a few tenths of a percent a swirl, at any voxel size). The field is
-        // axisymmetric about z through c with no swirl component, so it is the curl of
-        // psi (z x d) / rho^2, with Stokes stream function psi = lambda^4 / (2 r) (a / sqrt(a^2
-        // - 4 r^2 rho^2) - 1) (rho, zeta: distances from and along the axis). The curl of chi
-        // times that potential, chi going smoothly from 1 to 0 between half the reach and the
-        // reach, is the field times chi plus grad chi x the potential: divergence-free again.
+        // itself: cut off by itself, it would pour clay through the sphere, at any voxel size.
+        // The field is axisymmetric about z through c with no swirl component, so it is the
+        // curl of psi (z x d) / rho^2, with Stokes stream function psi = lambda^4 / (2 r)
+        // (a / sqrt(a^2 - 4 r^2 rho^2) - 1) (rho, zeta: distances from and along the axis).
+        // The curl of chi times that potential, chi going smoothly from 1 to 0 between half
+        // the reach and the reach, is the field times chi plus grad chi x the potential:
+        // divergence-free again.
         const double dist2 = d.squaredNorm(), dist = std::sqrt(dist2);
         const double chi = falloffMu(dist - inner_, reach_ - inner_);
         Eigen::Vector3d translation = chi * theta_ * b * (c.cross(eta) + a * z_);
