@@ -2,8 +2,11 @@
 // Analytic level sets for the engine tests, built voxel by voxel from exact distances.
 #pragma once
 
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <openvdb/tools/SignedFloodFill.h>
@@ -92,6 +95,31 @@ inline std::size_t changedOutside(const Grid& a, const Grid& b,
              !in.isValueOn(*it);
     }
     return n;
+}
+
+// A digest of every value of the grid (voxels and tiles, to the bit), its state, and where it
+// lies: 16 hex digits (64-bit FNV-1a over the tree's walk). Two grids with the same digest
+// hold the same values; a grid written before a change of the code and one written after it
+// are compared by their digests alone.
+inline std::string gridDigest(const Grid& g) {
+    std::uint64_t d = 0xcbf29ce484222325ull;
+    const auto mix = [&](const void* data, std::size_t n) {
+        const auto* bytes = static_cast<const unsigned char*>(data);
+        for (std::size_t i = 0; i < n; ++i) {
+            d ^= bytes[i];
+            d *= 0x100000001b3ull;
+        }
+    };
+    for (auto it = g.cbeginValueAll(); it; ++it) {
+        const openvdb::Coord c = it.getCoord();
+        const float v = *it;
+        const std::int32_t at[5] = {c.x(), c.y(), c.z(), int(it.getDepth()), int(it.isValueOn())};
+        mix(at, sizeof at);
+        mix(&v, sizeof v);
+    }
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(d));
+    return hex;
 }
 
 } // namespace sweepers::test
