@@ -393,7 +393,7 @@ int runApply(const ApplyArgs& a) {
 
     AdvectOptions options;
     options.resampleEachSubStep = a.perSubStep;
-    options.renormalization = a.firstOrder ? FmmOrder::First : FmmOrder::Second;
+    options.renormalization = a.firstOrder ? UpwindOrder::First : UpwindOrder::Second;
     options.sampling = a.cubic       ? Sampling::MonotoneCubic
                        : a.trilinear ? Sampling::Trilinear
                                      : Sampling::Corrected;

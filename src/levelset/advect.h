@@ -24,29 +24,17 @@
 #include <vector>
 
 #include "deform/step_deformation.h"
-#include "levelset/fast_marching.h"
 #include "levelset/interrupt.h"
+#include "levelset/renormalize.h"
+#include "levelset/resample.h"
 #include "levelset/vdb.h"
 
 namespace sweepers {
 
-// How sampling reads the grid between its voxels.
-//  Trilinear: the thesis's (5.3.2). Its error is half the second differences times
-//    t (1 - t) along each axis: it reads a distance high next to a convex surface (inside
-//    and out) and low next to a concave one, and rounds the shape off at every segment.
-//  Corrected: trilinear less that term, with the second differences of the cell's corners
-//    interpolated, where the value lies within two and a half voxels of the surface (farther
-//    out the differences read the band's clamp): it reads every quadratic field exactly. Its
-//    seeds are divided by the stretch the segment made (fast_marching.h), not by their
-//    gradient's norm, which reads low wherever the surface curves within a few voxels and
-//    would let it creep.
-//  MonotoneCubic: the monotone cubic of appendix C.1 (64 values per sample).
-enum class Sampling { Trilinear, Corrected, MonotoneCubic };
-
 struct AdvectOptions {
     bool resampleEachSubStep = false; // the thesis's 5.3.4 variant
     Sampling sampling = Sampling::Corrected;
-    FmmOrder renormalization = FmmOrder::Second;
+    UpwindOrder renormalization = UpwindOrder::Second;
     bool renormalize = true;
     Interrupter* interrupter = nullptr; // polled per leaf range; throws Cancelled
 };
@@ -130,8 +118,5 @@ AdvectStats advectSegment(Grid& grid, const StepDeformation& segment,
 
 // The index box whose voxels advectSegment(grid, segment) may change (what undo saves).
 openvdb::CoordBBox changedRegion(const Grid& grid, const StepDeformation& segment);
-
-// The index box of a world box, grown by `pad` voxels.
-openvdb::CoordBBox indexBox(const Grid& grid, const Box& world, int pad);
 
 } // namespace sweepers

@@ -7,7 +7,7 @@
 #include <openvdb/tools/LevelSetSphere.h>
 #include <openvdb/tools/MeshToVolume.h>
 
-#include "levelset/fast_marching.h"
+#include "levelset/renormalize.h"
 
 namespace sweepers {
 
@@ -64,7 +64,9 @@ GridPtr levelSetFromMesh(const std::vector<Eigen::Vector3f>& vertices,
     // raises distances near the edges between triangles past the half-width, and its
     // expansion leaves gaps without it): marched again from the surface, it holds every voxel
     // nearer the surface than its edge, as a sculpted band does.
-    renormalizeAll(*g, FmmOrder::Second, interrupter);
+    RenormalizeOptions whole;
+    whole.interrupter = interrupter;
+    renormalize(*g, whole);
     return g;
 }
 

@@ -13,7 +13,7 @@
 #include <tbb/parallel_reduce.h>
 
 #include "levelset/create.h"
-#include "levelset/fast_marching.h"
+#include "levelset/renormalize.h"
 
 namespace sweepers {
 
@@ -185,7 +185,9 @@ GridPtr bakeToolGrid(const Grid& levelSet, double reach, Interrupter* interrupte
         for (auto v = grown->cbeginValueOn(); v; ++v)
             if (acc.getValue(v.getCoord()) > 0.0f) acc.setValueOn(v.getCoord());
         pollInterrupt(interrupter);
-        renormalizeAll(*g, FmmOrder::Second, interrupter);
+        RenormalizeOptions whole;
+        whole.interrupter = interrupter;
+        renormalize(*g, whole);
     }
     return g;
 }

@@ -12,9 +12,9 @@
 #include "core/limits.h"
 #include "core/stopwatch.h"
 #include "levelset/dilate.h"
-#include "levelset/fast_marching.h"
 #include "levelset/padded_leaf.h"
 #include "levelset/parallel.h"
+#include "levelset/renormalize.h"
 
 namespace sweepers {
 
@@ -441,7 +441,12 @@ void CurvatureSmoother::renormalizeReach() {
         VoxelList moved = changed_;
         freed.insert(freed.end(), fresh_.begin(), fresh_.end());
         moved.insert(moved.end(), fresh_.begin(), fresh_.end());
-        renormalize(grid_, reach_, freed, moved, FmmOrder::Second, interrupter_);
+        RenormalizeOptions o;
+        o.region = reach_;
+        o.only = &freed;
+        o.moved = &moved;
+        o.interrupter = interrupter_;
+        renormalize(grid_, o);
         return;
     }
     VoxelList inside;
@@ -452,7 +457,11 @@ void CurvatureSmoother::renormalizeReach() {
         clip(lv);
         if (leafwords::any(lv.words)) inside.push_back(lv);
     }
-    renormalize(grid_, reach_, inside, FmmOrder::Second, interrupter_);
+    RenormalizeOptions o;
+    o.region = reach_;
+    o.only = &inside;
+    o.interrupter = interrupter_;
+    renormalize(grid_, o);
 }
 
 SmoothStats smoothLevelSet(Grid& grid, const SmoothBrush& brush, Interrupter* interrupter,

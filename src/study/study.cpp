@@ -83,7 +83,7 @@ AdvectOptions variantOptions(StudyVariant v) {
                  : v == StudyVariant::Trilinear ? Sampling::Trilinear
                                                 : Sampling::Corrected;
     o.resampleEachSubStep = v == StudyVariant::PerSubStep;
-    o.renormalization = v == StudyVariant::FirstOrder ? FmmOrder::First : FmmOrder::Second;
+    o.renormalization = v == StudyVariant::FirstOrder ? UpwindOrder::First : UpwindOrder::Second;
     return o;
 }
 

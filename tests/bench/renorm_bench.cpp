@@ -15,7 +15,7 @@
 
 #include "bench.h"
 #include "levelset/create.h"
-#include "levelset/fast_marching.h"
+#include "levelset/renormalize.h"
 #include "mesh/marching_cubes.h"
 
 namespace sweepers::bench {
@@ -88,22 +88,22 @@ void registerCase(const std::string& item, std::function<Case()> make) {
         return **shared;
     };
     const std::string base = "renorm/" + item + "/";
-    auto fmm = [get](FmmOrder order, bool local) {
+    auto fmm = [get](UpwindOrder order, bool local) {
         return [get, order, local](benchmark::State& state) {
             const Case& c = get();
             const GridPtr g = timedOnCopies(state, *c.grid, [&](Grid& grid) {
-                if (local)
-                    renormalize(grid, c.local, order);
-                else
-                    renormalizeAll(grid, order);
+                RenormalizeOptions o;
+                if (local) o.region = c.local;
+                o.order = order;
+                renormalize(grid, o);
             });
             report(state, *g, c);
         };
     };
-    add(base + "sweepers_fmm1", fmm(FmmOrder::First, false), 3);
-    add(base + "sweepers_fmm2", fmm(FmmOrder::Second, false), 3);
+    add(base + "sweepers_fmm1", fmm(UpwindOrder::First, false), 3);
+    add(base + "sweepers_fmm2", fmm(UpwindOrder::Second, false), 3);
     if (item.rfind("stroke", 0) == 0)
-        add(base + "sweepers_fmm2_stroke_region", fmm(FmmOrder::Second, true), 3);
+        add(base + "sweepers_fmm2_stroke_region", fmm(UpwindOrder::Second, true), 3);
     add(
         base + "openvdb_sdfToSdf",
         [get](benchmark::State& state) {

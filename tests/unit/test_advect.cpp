@@ -19,6 +19,7 @@
 #include "io/stroke_script.h"
 #include "levelset/advect.h"
 #include "levelset/band.h"
+#include "levelset/band_growth.h"
 #include "levelset/create.h"
 #include "levelset/measure.h"
 #include "levelset/monotone_cubic.h"
@@ -451,7 +452,7 @@ TEST(Advect, ShapesWhereTheDeformationIsTheIdentityCostNoWork) {
 TEST(Advect, ASegmentRenormalizesEverythingItChanged) {
     const double h = 1.0 / 64;
     GridPtr part = makeSphere({0, 0, 0}, 1.0, h, 3.0);
-    renormalizeAll(*part);
+    renormalize(*part);
     GridPtr whole = part->deepCopy();
     const Sweep sweep{{{std::make_shared<EllipsoidShape>(0.25),
                         0.25,
@@ -461,7 +462,9 @@ TEST(Advect, ASegmentRenormalizesEverythingItChanged) {
     sampleOnly.renormalize = false;
     for (std::size_t k = 0; k < sweep.segmentCount(); ++k) {
         advectSegment(*part, SweepSegment(sweep, k), trilinear);
-        renormalize(*whole, advectSegment(*whole, SweepSegment(sweep, k), sampleOnly).touched);
+        RenormalizeOptions box;
+        box.region = advectSegment(*whole, SweepSegment(sweep, k), sampleOnly).touched;
+        renormalize(*whole, box);
     }
     auto a = part->getConstAccessor();
     auto b = whole->getConstAccessor();

@@ -18,9 +18,9 @@
 #include "io/vdb_file.h"
 #include "levelset/band.h"
 #include "levelset/create.h"
-#include "levelset/fast_marching.h"
 #include "levelset/measure.h"
 #include "levelset/raycast.h"
+#include "levelset/renormalize.h"
 #include "replay.h"
 #include "scratch_dir.h"
 
@@ -238,7 +238,9 @@ TEST(Cancel, EveryLongOperationStopsAndLeavesItsInputAsItWas) {
             it.setValue(1.5f * *it); // no longer a distance
         const GridPtr stretched = g->deepCopy();
         StopAfter stop(2);
-        EXPECT_THROW(renormalizeAll(*g, FmmOrder::Second, &stop), Cancelled);
+        RenormalizeOptions o;
+        o.interrupter = &stop;
+        EXPECT_THROW(renormalize(*g, o), Cancelled);
         EXPECT_EQ(differingVoxels(*stretched, *g), 0u);
     }
     // Whole-grid meshing: the mesher keeps its mesh.

@@ -22,7 +22,7 @@ using namespace sweepers;
 namespace {
 
 // The RMS difference of two grids in voxels, over the voxels next to the surface of `a`.
-double interfaceRms(const Grid& a, const Grid& b) {
+double rmsNearTheSurfaceOf(const Grid& a, const Grid& b) {
     const double h = a.voxelSize()[0];
     const auto bacc = b.getConstAccessor();
     double sum = 0.0;
@@ -63,7 +63,7 @@ TEST(Flow, ARotationFieldTurnsTheShapeAsARotatingSweepDoes) {
     Sculptor swept(start()), flowed(start());
     swept.applyStroke(sweep);
     flowed.applyStroke(flow);
-    const double rms = interfaceRms(swept.grid(), flowed.grid());
+    const double rms = rmsNearTheSurfaceOf(swept.grid(), flowed.grid());
     std::printf("rotation as a field against the sweep: %.4f voxel RMS\n", rms);
     EXPECT_LT(rms, 0.05);
     // It did turn: the ball's centre went from +x to +y.
@@ -110,7 +110,7 @@ TEST(Flow, ARotationSampledInAVdbFileTurnsTheShapeAsTheFieldDoes) {
             "sampled.json");
         Sculptor sampled(start());
         sampled.applyStroke(script.strokes.at(0));
-        const double rms = interfaceRms(analytic.grid(), sampled.grid());
+        const double rms = rmsNearTheSurfaceOf(analytic.grid(), sampled.grid());
         std::printf("rotation sampled in a VDB (%s) against the field: %.4f voxel RMS\n",
                     staggered ? "staggered" : "cell-centred", rms);
         EXPECT_LT(rms, 0.05);
@@ -166,7 +166,7 @@ TEST(Flow, EnrightsSphereComesBackAtTheEndOfThePeriod) {
     std::size_t segments = 0;
     s.applyStroke(flow, [&](const SegmentReport&) { ++segments; });
     const double v0 = levelSetVolume(*start), v1 = levelSetVolume(s.grid());
-    const double rms = interfaceRms(*start, s.grid());
+    const double rms = rmsNearTheSurfaceOf(*start, s.grid());
     std::printf("Enright at 1/64 to t = 3: %zu segment(s), volume %+.4f%%, %.4f voxel RMS\n",
                 segments, 100.0 * (v1 - v0) / v0, rms);
     EXPECT_LT(std::abs(v1 - v0), 0.01 * v0);

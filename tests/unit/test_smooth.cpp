@@ -21,8 +21,8 @@
 #include "io/study_files.h"
 #include "levelset/band.h"
 #include "levelset/create.h"
-#include "levelset/fast_marching.h"
 #include "levelset/measure.h"
+#include "levelset/renormalize.h"
 #include "levelset/smooth.h"
 #include "sculpt/sculptor.h"
 #include "study/study.h"
@@ -268,7 +268,7 @@ GridPtr ridgedSphere(double h, double l, double amplitude) {
         const double d = p.norm() - 0.5 - amplitude * std::sin(k * p.x());
         it.setValue(float(std::clamp(d, -double(bg), double(bg))));
     }
-    renormalizeAll(*g);
+    renormalize(*g);
     return g;
 }
 

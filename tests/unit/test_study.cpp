@@ -35,7 +35,7 @@ TEST(Study, VariantNamesRoundTrip) {
     EXPECT_FALSE(parseVariant("quintic"));
     EXPECT_TRUE(variantOptions(StudyVariant::PerSubStep).resampleEachSubStep);
     EXPECT_EQ(variantOptions(StudyVariant::Cubic).sampling, Sampling::MonotoneCubic);
-    EXPECT_EQ(variantOptions(StudyVariant::FirstOrder).renormalization, FmmOrder::First);
+    EXPECT_EQ(variantOptions(StudyVariant::FirstOrder).renormalization, UpwindOrder::First);
 }
 
 TEST(Study, OrdersCompareEachRunWithTheNextCoarserOfItsVariant) {

@@ -17,10 +17,9 @@
 
 #include "grids.h"
 #include "levelset/band.h"
-#include "levelset/fast_marching.h"
 #include "levelset/leaf_words.h"
-#include "levelset/local_tree.h"
 #include "levelset/peer_check.h"
+#include "levelset/renormalize.h"
 #include "levelset/upwind_row.h"
 
 using namespace sweepers;
@@ -56,10 +55,28 @@ Errors compare(const Grid& g, const std::function<double(const Eigen::Vector3d&)
     return e;
 }
 
+// The options that renormalize the voxels of `region` (of `only`, where given), seeding again
+// only next to `moved` (where given).
+RenormalizeOptions within(const openvdb::CoordBBox& region, const VoxelList* only = nullptr,
+                          const VoxelList* moved = nullptr) {
+    RenormalizeOptions o;
+    o.region = region;
+    o.only = only;
+    o.moved = moved;
+    return o;
+}
+
+// The whole band, with the first-order stencil.
+RenormalizeOptions firstOrder() {
+    RenormalizeOptions o;
+    o.order = UpwindOrder::First;
+    return o;
+}
+
 // Renormalizes all of g and compares it with sdf (printed as `what`); no sign may flip.
 Errors renormalizedAgainst(Grid& g, const std::function<double(const Eigen::Vector3d&)>& sdf,
                            const char* what) {
-    renormalizeAll(g);
+    renormalize(g);
     const Errors e = compare(g, sdf);
     std::printf("[ fmm ] %s, renormalized: next to the surface max error %.3f voxel, rms %.3f\n",
                 what, e.maxNear, e.rmsNear);
@@ -99,8 +116,8 @@ void renormalizes(const char* name, GridPtr g,
     distort(*g);
     const Errors before = compare(*g, sdf);
     GridPtr first = g->deepCopy();
-    renormalizeAll(*first, FmmOrder::First);
-    renormalizeAll(*g, FmmOrder::Second);
+    renormalize(*first, firstOrder());
+    renormalize(*g);
     const Errors e1 = compare(*first, sdf), e2 = compare(*g, sdf);
     std::printf("[ fmm ] %-6s distorted: max band error %.3f voxels; first order: near max %.4f "
                 "rms %.4f band max %.3f; second order: near max %.4f rms %.4f band max %.3f\n",
@@ -171,9 +188,9 @@ void solvesTheUpwindEquations(const char* name, GridPtr g,
                               const openvdb::CoordBBox& region = openvdb::CoordBBox::inf()) {
     distort(*g);
     if (region == openvdb::CoordBBox::inf())
-        renormalizeAll(*g, FmmOrder::Second);
+        renormalize(*g);
     else
-        renormalize(*g, region, FmmOrder::Second);
+        renormalize(*g, within(region));
     const double h = g->voxelSize()[0], bg = g->background();
     const auto acc = g->getConstAccessor();
     const auto across = [&](const openvdb::Coord& ijk) {
@@ -231,12 +248,14 @@ void renormalizeAllMoved(Grid& g, Seeding seeding) {
         all.push_back(activeVoxelsOf(*leaf));
     openvdb::CoordBBox region = g.evalActiveVoxelBoundingBox();
     region.expand(2);
-    renormalize(g, region, all, all, FmmOrder::Second, nullptr, seeding);
+    RenormalizeOptions o = within(region, &all, &all);
+    o.seeding = seeding;
+    renormalize(g, o);
 }
 
 } // namespace
 
-TEST(FastMarching, SolvesTheUpwindEquationsAcrossLeaves) {
+TEST(Renormalize, SolvesTheUpwindEquationsAcrossLeaves) {
     const double h = 1.0 / 48;
     auto sphere = [](const Eigen::Vector3d& p) { return p.norm() - 0.8; };
     solvesTheUpwindEquations(
@@ -248,7 +267,7 @@ TEST(FastMarching, SolvesTheUpwindEquationsAcrossLeaves) {
 
 // Renormalizing part of the band, as a stroke segment does: the voxels solved hold their
 // upwind values, those at the edge of the part reading the kept (distorted) values beyond it.
-TEST(FastMarching, SolvesTheUpwindEquationsInAPartOfTheBand) {
+TEST(Renormalize, SolvesTheUpwindEquationsInAPartOfTheBand) {
     const double h = 1.0 / 48;
     auto torus = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
     solvesTheUpwindEquations(
@@ -263,7 +282,7 @@ TEST(FastMarching, SolvesTheUpwindEquationsInAPartOfTheBand) {
 // scaled by 1.3, and L's face layer (x = -1) is kept. N is solved first (its leaf position's
 // parity is even) from L's old values, two voxels in: handed nothing, N's face voxels would
 // keep what those gave, 0.14 voxel off their upwind value.
-TEST(FastMarching, AChangeOneLayerInFromAFaceReachesTheNeighbour) {
+TEST(Renormalize, AChangeOneLayerInFromAFaceReachesTheNeighbour) {
     const double h = 1.0 / 48;
     const double plane = documentTransform(h)->indexToWorld(openvdb::Vec3d(-3.5, 0, 0)).x();
     GridPtr g = gridFromSdf([&](const Eigen::Vector3d& p) { return p.x() - plane; }, h, 6,
@@ -276,7 +295,8 @@ TEST(FastMarching, AChangeOneLayerInFromAFaceReachesTheNeighbour) {
         n.words[x] = ~leafwords::Word(0);
     }
     const openvdb::CoordBBox both({-8, 0, 0}, {7, 7, 7});
-    renormalize(*g, both, VoxelList{l, n}, FmmOrder::Second);
+    const VoxelList listed{l, n};
+    renormalize(*g, within(both, &listed));
     const auto acc = g->getConstAccessor();
     double worst = 0.0;
     std::size_t solved = 0;
@@ -295,21 +315,21 @@ TEST(FastMarching, AChangeOneLayerInFromAFaceReachesTheNeighbour) {
     EXPECT_NEAR(acc.getValue({0, 3, 3}), (4.0 * kept - beyond) / 3.0 + h / 1.5, 1e-4 * h);
 }
 
-TEST(FastMarching, RenormalizesADistortedSphere) {
+TEST(Renormalize, RenormalizesADistortedSphere) {
     const double h = 1.0 / 48;
     auto sdf = [](const Eigen::Vector3d& p) { return p.norm() - 0.8; };
     renormalizes("sphere",
                  gridFromSdf(sdf, h, 3, openvdb::CoordBBox::createCube({-45, -45, -45}, 90)), sdf);
 }
 
-TEST(FastMarching, RenormalizesADistortedTorus) {
+TEST(Renormalize, RenormalizesADistortedTorus) {
     const double h = 1.0 / 48;
     auto sdf = [](const Eigen::Vector3d& p) { return test::torusSdf(p, 0.6, 0.25); };
     renormalizes("torus",
                  gridFromSdf(sdf, h, 3, openvdb::CoordBBox::createCube({-45, -45, -20}, 90)), sdf);
 }
 
-TEST(FastMarching, ThinRodSurvivesManyRenormalizations) {
+TEST(Renormalize, ThinRodSurvivesManyRenormalizations) {
     // A rod two voxels thick along a diagonal of the lattice.
     const double h = 1.0 / 32;
     const Eigen::Vector3d axis = Eigen::Vector3d(1, 2, 0.5).normalized();
@@ -323,7 +343,7 @@ TEST(FastMarching, ThinRodSurvivesManyRenormalizations) {
     const double v0 = openvdb::tools::levelSetVolume(*g);
     ASSERT_GT(v0, 0.0);
     for (int i = 0; i < 100; ++i) {
-        renormalizeAll(*g, FmmOrder::Second);
+        renormalize(*g);
         if (i == 0 || i == 9)
             std::printf("[ fmm ] rod volume after %d: %.6g\n", i + 1,
                         openvdb::tools::levelSetVolume(*g));
@@ -337,18 +357,18 @@ TEST(FastMarching, ThinRodSurvivesManyRenormalizations) {
 // The leaves of one class are solved at once, so no two of them may share a face (a leaf
 // reads its face neighbours' values): the result is then the same on one thread as on two,
 // to the bit, however the threads share the leaves.
-TEST(FastMarching, OneThreadAndTwoGiveTheSameBand) {
+TEST(Renormalize, OneThreadAndTwoGiveTheSameBand) {
     const GridPtr g = distortedTorus();
     GridPtr one = g->deepCopy();
     {
         const tbb::global_control serial(tbb::global_control::max_allowed_parallelism, 1);
-        renormalizeAll(*one);
+        renormalize(*one);
     }
     for (int run = 0; run < 3; ++run) {
         GridPtr two = g->deepCopy();
         {
             const tbb::global_control pair(tbb::global_control::max_allowed_parallelism, 2);
-            renormalizeAll(*two);
+            renormalize(*two);
         }
         EXPECT_EQ(one->tree().leafCount(), two->tree().leafCount());
         EXPECT_EQ(sweepers::test::differingVoxels(*one, *two), 0u) << "run " << run;
@@ -358,7 +378,7 @@ TEST(FastMarching, OneThreadAndTwoGiveTheSameBand) {
 // A leaf the renormalized band leaves without an active voxel becomes a tile of its sign:
 // here the sphere's surface moves two voxels in (its outer band's leaves fall empty) or out
 // (its inner band's).
-TEST(FastMarching, ALeafLeftWithoutBandBecomesATileOfItsSide) {
+TEST(Renormalize, ALeafLeftWithoutBandBecomesATileOfItsSide) {
     const double h = 1.0 / 48;
     auto sdf = [](const Eigen::Vector3d& p) { return p.norm() - 0.8; }; // 38.4 voxels
     for (const int in : {1, -1}) {
@@ -374,7 +394,7 @@ TEST(FastMarching, ALeafLeftWithoutBandBecomesATileOfItsSide) {
             origins.push_back(leaf->origin());
         openvdb::CoordBBox region = g->evalActiveVoxelBoundingBox();
         region.expand(2);
-        renormalize(*g, region);
+        renormalize(*g, within(region));
         std::size_t empty = 0;
         for (auto leaf = g->tree().cbeginLeaf(); leaf; ++leaf)
             empty += leaf->isEmpty();
@@ -401,7 +421,7 @@ TEST(FastMarching, ALeafLeftWithoutBandBecomesATileOfItsSide) {
 // A shape far from another (here a copy of it, 4,000 voxels away on every axis) is
 // renormalized as it is alone, to the bit: the band's leaves find their neighbours in a
 // table over their box, and where the box is mostly empty, as here, in a sorted list.
-TEST(FastMarching, AShapeFarFromAnotherIsRenormalizedAsAlone) {
+TEST(Renormalize, AShapeFarFromAnotherIsRenormalizedAsAlone) {
     const GridPtr alone = distortedTorus(), distorted = distortedTorus();
     GridPtr pair = alone->deepCopy();
     const openvdb::Coord away(4000, 4000, 4000); // a whole number of leaves
@@ -410,8 +430,8 @@ TEST(FastMarching, AShapeFarFromAnotherIsRenormalizedAsAlone) {
         copy->setOrigin(leaf->origin() + away);
         pair->tree().addLeaf(copy);
     }
-    renormalizeAll(*alone);
-    renormalizeAll(*pair);
+    renormalize(*alone);
+    renormalize(*pair);
     std::size_t leaves = 0, differ = 0, moved = 0;
     for (auto leaf = alone->tree().cbeginLeaf(); leaf; ++leaf)
         for (const openvdb::Coord& at : {leaf->origin(), leaf->origin() + away}) {
@@ -434,7 +454,7 @@ TEST(FastMarching, AShapeFarFromAnotherIsRenormalizedAsAlone) {
 
 // With `only`, the voxels it lists are renormalized and the others keep their values; a leaf
 // listed twice, its voxels split between the entries, is renormalized as when listed once.
-TEST(FastMarching, OnlyTheListedVoxelsAreRenormalized) {
+TEST(Renormalize, OnlyTheListedVoxelsAreRenormalized) {
     const GridPtr distorted = distortedTorus();
     VoxelList once, twice; // the active voxels of the leaves with x < 0
     for (auto leaf = distorted->tree().cbeginLeaf(); leaf; ++leaf) {
@@ -450,8 +470,8 @@ TEST(FastMarching, OnlyTheListedVoxelsAreRenormalized) {
     openvdb::CoordBBox region = distorted->evalActiveVoxelBoundingBox();
     region.expand(2);
     GridPtr a = distorted->deepCopy(), b = distorted->deepCopy();
-    renormalize(*a, region, once);
-    renormalize(*b, region, twice);
+    renormalize(*a, within(region, &once));
+    renormalize(*b, within(region, &twice));
     EXPECT_EQ(sweepers::test::differingVoxels(*a, *b), 0u);
     const auto before = distorted->getConstAccessor();
     std::size_t kept = 0, moved = 0;
@@ -471,7 +491,7 @@ TEST(FastMarching, OnlyTheListedVoxelsAreRenormalized) {
 // Given the voxels it may free, renormalization takes the leaves holding them and those around
 // them (face, edge or corner) as its domain, not every leaf of the region: a shape elsewhere
 // in the region adds no leaf to it, and the listed shape's values come out the same.
-TEST(FastMarching, TheDomainIsTheLeavesAroundTheListedOnes) {
+TEST(Renormalize, TheDomainIsTheLeavesAroundTheListedOnes) {
     const GridPtr torus = distortedTorus();
     VoxelList listed;               // the active voxels of the leaves with x < 0
     std::vector<openvdb::Coord> at; // their positions, in leaves
@@ -499,8 +519,8 @@ TEST(FastMarching, TheDomainIsTheLeavesAroundTheListedOnes) {
     openvdb::CoordBBox region = both->evalActiveVoxelBoundingBox();
     region.expand(2);
     GridPtr one = torus->deepCopy();
-    const FmmStats alone = renormalize(*one, region, listed);
-    const FmmStats beside = renormalize(*both, region, listed);
+    const RenormalizeStats alone = renormalize(*one, within(region, &listed));
+    const RenormalizeStats beside = renormalize(*both, within(region, &listed));
     EXPECT_EQ(alone.leaves, near);
     EXPECT_EQ(beside.leaves, near);
     EXPECT_LT(near, all);
@@ -523,7 +543,7 @@ TEST(FastMarching, TheDomainIsTheLeavesAroundTheListedOnes) {
 // same values and the same moved lanes, to the bit, with either stencil. (Both halves of a
 // row are solved from the row as it was: a half written before the other was solved would
 // feed it new values.)
-TEST(FastMarching, RowUpdatesAreTheSameInFourLanesAndInEight) {
+TEST(Renormalize, RowUpdatesAreTheSameInFourLanesAndInEight) {
     if (!upwind::detail::hasAvx2()) GTEST_SKIP() << "no AVX2: relaxRow has one way only";
     std::mt19937 random(11);
     const float h = 1.0f / 128, inf = std::numeric_limits<float>::infinity();
@@ -555,7 +575,7 @@ TEST(FastMarching, RowUpdatesAreTheSameInFourLanesAndInEight) {
 // A row returns at once when none of its lanes can come back from +infinity (their
 // neighbours lie too near the background or past it): a lane solved alone takes that way
 // where the row solved whole does not, so each lane must come out the same either way.
-TEST(FastMarching, ALaneOfARowSolvesTheSameAloneAsWithTheOthers) {
+TEST(Renormalize, ALaneOfARowSolvesTheSameAloneAsWithTheOthers) {
     std::mt19937 random(12);
     const float h = 1.0f / 128, inf = std::numeric_limits<float>::infinity();
     // Values near the band's edge (3 h), half of them none (+infinity).
@@ -586,115 +606,12 @@ TEST(FastMarching, ALaneOfARowSolvesTheSameAloneAsWithTheOthers) {
     EXPECT_GT(cameBack, 200); // lanes that were +infinity and took a value: the case tested
 }
 
-// The signs of a leaf's values, four at a time where the CPU can: bit k is `v[k] < 0` for any
-// count and any alignment, with zeros of either sign, infinities and NaN among the values.
-TEST(LeafWords, NegativesAreTheSignsOfTheValues) {
-    std::mt19937 random(13);
-    const float specials[] = {0.0f,
-                              -0.0f,
-                              std::numeric_limits<float>::infinity(),
-                              -std::numeric_limits<float>::infinity(),
-                              std::numeric_limits<float>::quiet_NaN(),
-                              -std::numeric_limits<float>::quiet_NaN(),
-                              std::numeric_limits<float>::denorm_min(),
-                              -std::numeric_limits<float>::denorm_min()};
-    std::uniform_real_distribution<float> value(-1.0f, 1.0f);
-    std::uniform_int_distribution<int> kind(0, 15);
-    std::vector<float> v(80);
-    for (int trial = 0; trial < 500; ++trial) {
-        for (float& x : v) {
-            const int k = kind(random);
-            x = k < 8 ? specials[k] : value(random);
-        }
-        const int first = trial % 8, n = 1 + trial % 64;
-        leafwords::Word expected = 0;
-        for (int k = 0; k < n; ++k)
-            expected |= leafwords::Word(v[std::size_t(first + k)] < 0.0f) << k;
-        ASSERT_EQ(expected, leafwords::negatives(v.data() + first, n)) << "trial " << trial;
-    }
-}
-
-// The bounds of a leaf's voxel set are those of its voxels, one by one (sets of one voxel,
-// a few, and many).
-TEST(LeafWords, BoundsAreThoseOfTheVoxels) {
-    std::mt19937 random(17);
-    std::uniform_int_distribution<int> voxel(0, 511), count(1, 40);
-    for (int trial = 0; trial < 500; ++trial) {
-        leafwords::Words set{};
-        int want[2][3] = {{8, 8, 8}, {-1, -1, -1}};
-        for (int n = trial < 100 ? 1 : count(random); n > 0; --n) {
-            const int v = voxel(random), c[3] = {v >> 6, (v >> 3) & 7, v & 7};
-            set[std::size_t(c[0])] |= leafwords::Word(1) << (v & 63);
-            for (int a = 0; a < 3; ++a) {
-                want[0][a] = std::min(want[0][a], c[a]);
-                want[1][a] = std::max(want[1][a], c[a]);
-            }
-        }
-        int lo[3], hi[3];
-        leafwords::bounds(set, lo, hi);
-        for (int a = 0; a < 3; ++a) {
-            ASSERT_EQ(lo[a], want[0][a]) << "trial " << trial << ", axis " << a;
-            ASSERT_EQ(hi[a], want[1][a]) << "trial " << trial << ", axis " << a;
-        }
-    }
-}
-
-// A leaf's inactive values take the signs OpenVDB's signed flood fill gives them, to the bit:
-// leaves with no active voxel, a few, half, nearly all and all of them, values of both signs
-// with zeros of either sign, infinities and NaN among them.
-TEST(LocalTree, LeafSignsAreFloodedAsOpenVdbFloodsThem) {
-    std::mt19937 random(29);
-    const float specials[] = {0.0f, -0.0f, std::numeric_limits<float>::infinity(),
-                              -std::numeric_limits<float>::infinity(),
-                              std::numeric_limits<float>::quiet_NaN()};
-    std::uniform_real_distribution<float> value(-1.0f, 1.0f), unit(0.0f, 1.0f);
-    std::uniform_int_distribution<int> kind(0, 31);
-    const double densities[] = {0.0, 0.002, 0.02, 0.3, 0.5, 0.9, 0.998, 1.0};
-    Grid::TreeType tree(0.25f);
-    const openvdb::tools::SignedFloodFillOp<Grid::TreeType> openvdbFill(tree);
-    int changed = 0;
-    for (int trial = 0; trial < 400; ++trial) {
-        LeafNode leaf(openvdb::Coord(8, -16, 0), 0.0f);
-        const double density = densities[trial % 8];
-        for (openvdb::Index i = 0; i < LeafNode::SIZE; ++i) {
-            const int k = kind(random);
-            leaf.setValueOnly(i, k < 5 ? specials[k] : value(random));
-            leaf.setActiveState(i, unit(random) < density);
-        }
-        LeafNode expected(leaf), ours(leaf);
-        openvdbFill(expected);
-        floodLeafSigns(ours, -0.25f, 0.25f);
-        ASSERT_EQ(0, std::memcmp(expected.buffer().data(), ours.buffer().data(),
-                                 sizeof(float) * LeafNode::SIZE))
-            << "trial " << trial << ", density " << density;
-        changed += std::memcmp(leaf.buffer().data(), ours.buffer().data(),
-                               sizeof(float) * LeafNode::SIZE) != 0;
-    }
-    EXPECT_GT(changed, 300); // leaves the fill changed: the case tested
-}
-
-// A tree freed on the calling thread is empty and can be used again, and every node it held
-// is freed (the sanitizers' run finds any that is not).
-TEST(LocalTree, ATreeFreedOnThisThreadIsEmpty) {
-    openvdb::MaskTree tree;
-    for (int i = 0; i < 40; ++i)
-        tree.touchLeaf(openvdb::Coord(8 * i, -300 * i, 5000 - 64 * i))->setValueOn(i);
-    tree.addTile(1, openvdb::Coord(4096, 0, 0), true, true); // an active tile, a leaf in size
-    ASSERT_EQ(tree.leafCount(), 40u);
-    freeOnThisThread(tree);
-    EXPECT_EQ(tree.leafCount(), 0u);
-    EXPECT_EQ(tree.activeVoxelCount(), 0u);
-    EXPECT_TRUE(tree.empty());
-    tree.touchLeaf(openvdb::Coord(1, 2, 3))->setValueOn(0);
-    EXPECT_EQ(tree.activeVoxelCount(), 1u);
-}
-
 // Renormalizing again seeds where nothing moved only if told nothing moved there. Two
 // overlapping balls meet in a valley, a crease the 1/48 grid resolves only roughly: their
 // exact distance, seeded again and again, creeps (central differences across the valley read
 // a gradient below 1). Told that only the far cap of one ball moved, eight renormalizations
 // leave every seed whose stencil holds no moved voxel exactly as it was.
-TEST(FastMarching, SeedsWhoseStencilDidNotMoveKeepTheirValues) {
+TEST(Renormalize, SeedsWhoseStencilDidNotMoveKeepTheirValues) {
     const auto sdf = [](const Eigen::Vector3d& p) {
         return std::min((p - Eigen::Vector3d(-0.32, 0.0, 0.0)).norm(),
                         (p - Eigen::Vector3d(0.32, 0.0, 0.0)).norm()) -
@@ -711,8 +628,8 @@ TEST(FastMarching, SeedsWhoseStencilDidNotMoveKeepTheirValues) {
     region.expand(2);
     GridPtr told = exact->deepCopy(), untold = exact->deepCopy();
     for (int pass = 0; pass < 8; ++pass) {
-        renormalize(*told, region, all, cap);
-        renormalize(*untold, region, all);
+        renormalize(*told, within(region, &all, &cap));
+        renormalize(*untold, within(region, &all));
     }
     const auto was = exact->getConstAccessor(), t = told->getConstAccessor(),
                u = untold->getConstAccessor();
@@ -738,7 +655,7 @@ TEST(FastMarching, SeedsWhoseStencilDidNotMoveKeepTheirValues) {
 // where they were) comes back next to the surface within 0.15 voxel RMS of its exact distance
 // (0.11); the cap of a whole voxel it had before left 0.25, and a largest error of 0.43 voxel
 // where this leaves 0.34.
-TEST(FastMarching, ThinSeedsAreCappedByTheirNearestCrossing) {
+TEST(Renormalize, ThinSeedsAreCappedByTheirNearestCrossing) {
     const double h = 1.0 / 32;
     const Eigen::Vector3d axis = Eigen::Vector3d(1, 2, 0.5).normalized();
     const auto rod = [&](const Eigen::Vector3d& p) {
@@ -761,7 +678,7 @@ TEST(FastMarching, ThinSeedsAreCappedByTheirNearestCrossing) {
 // test refuses none of them. (When the row counted as thin, the seeds within two voxels kept
 // their values, capped only by their nearest axis crossing, a whole voxel away: 0.28 voxel
 // off, and the test refused 780 voxels.)
-TEST(FastMarching, ASurfaceAlongARowOfVoxelsIsNoThinFeature) {
+TEST(Renormalize, ASurfaceAlongARowOfVoxelsIsNoThinFeature) {
     const double h = 1.0 / 32;
     const Eigen::Vector3d n = Eigen::Vector3d(1, 0, 1).normalized();
     const auto plane = [&](const Eigen::Vector3d& p) { return p.dot(n); };
@@ -773,7 +690,7 @@ TEST(FastMarching, ASurfaceAlongARowOfVoxelsIsNoThinFeature) {
         if (across == 0) it.setValue(float(((c.y() & 1) ? 0.01 : -0.01) * h));
         if (across == 1 || across == -1) it.setValue(float(1.4 * *it));
     }
-    renormalizeAll(*g);
+    renormalize(*g);
     double worst = 0.0;
     for (auto it = g->cbeginValueOn(); it; ++it) {
         const openvdb::Coord c = it.getCoord();
@@ -804,7 +721,7 @@ TEST(FastMarching, ASurfaceAlongARowOfVoxelsIsNoThinFeature) {
 // leaves), has next to the surface a central gradient below 1, and phi / |grad phi| errs
 // high there. Seeds of a ball whose values were bent so (a = 0.2) come back next to the
 // surface within 0.045 voxel RMS and 0.1 at most of its distance.
-TEST(FastMarching, SeedsWhereTheFieldBendsComeBackToTheDistance) {
+TEST(Renormalize, SeedsWhereTheFieldBendsComeBackToTheDistance) {
     GridPtr g = bentBall(-0.2);
     const Errors e = renormalizedAgainst(*g, kBall, "a ball's values bent along the normal");
     EXPECT_LT(e.rmsNear, 0.045);
@@ -818,7 +735,7 @@ TEST(FastMarching, SeedsWhereTheFieldBendsComeBackToTheDistance) {
 // surface within 0.045 voxel RMS and 0.1 at most; as after a smooth deformation (Lower: the
 // second-order value only downwards) they stay as shallow as the first-order value leaves
 // them.
-TEST(FastMarching, AfterATearSeedsComeBackUpToTheDistance) {
+TEST(Renormalize, AfterATearSeedsComeBackUpToTheDistance) {
     const GridPtr bent = bentBall(0.2);
     for (const Seeding way : {Seeding::Either, Seeding::Lower}) {
         GridPtr g = bent->deepCopy();
@@ -845,7 +762,7 @@ TEST(FastMarching, AfterATearSeedsComeBackUpToTheDistance) {
 // tear: the first pass (Seeding::Either) leaves seeds that disagree with one another, and
 // OpenVDB's eikonal test refuses some; the second, seeded from the surface the first placed
 // (Seeding::Interface), leaves none refused, and its surface is no farther from the ball's.
-TEST(FastMarching, AfterATearASecondPassSeedsFromTheSurface) {
+TEST(Renormalize, AfterATearASecondPassSeedsFromTheSurface) {
     const double h = 1.0 / 32;
     GridPtr torn = gridFromSdf(kBall, h, 3, openvdb::CoordBBox::createCube({-20, -20, -20}, 40));
     for (auto it = torn->beginValueOn(); it; ++it) {
@@ -905,7 +822,7 @@ VoxelValues gradientNorms(const Grid& g) {
 // the stretch (the norms the values had before: the same field, a stretch of 1) they keep
 // their values to the bit. The same ball's values doubled (a stretch of 2, the norms before
 // the ball's) come back to its distance.
-TEST(FastMarching, SeedsDividedByTheStretchDoNotCreep) {
+TEST(Renormalize, SeedsDividedByTheStretchDoNotCreep) {
     const double h = 1.0 / 32, radius = 3 * h;
     const auto ball = [&](const Eigen::Vector3d& p) { return p.norm() - radius; };
     const GridPtr exact = gridFromSdf(ball, h, 3, openvdb::CoordBBox::createCube({-8, -8, -8}, 16));
@@ -921,8 +838,9 @@ TEST(FastMarching, SeedsDividedByTheStretchDoNotCreep) {
         GridPtr g = start.deepCopy();
         for (int k = 0; k < times; ++k) {
             const VoxelValues norms = k == 0 ? before : gradientNorms(*g);
-            renormalize(*g, region, all, all, FmmOrder::Second, nullptr, Seeding::Lower,
-                        byStretch ? &norms : nullptr);
+            RenormalizeOptions o = within(region, &all, &all);
+            o.gradientBefore = byStretch ? &norms : nullptr;
+            renormalize(*g, o);
         }
         return g;
     };
@@ -962,7 +880,7 @@ TEST(FastMarching, SeedsDividedByTheStretchDoNotCreep) {
 // norms before those of the ball's distance: its seeds come back to the distance to within
 // a hundredth of a voxel, where phi over the stretch misses it by seven hundredths (and the
 // second-order root capped by the linear crossing along an axis, by two).
-TEST(FastMarching, SeedsOfAStretchThatChangesAlongTheNormalComeBack) {
+TEST(Renormalize, SeedsOfAStretchThatChangesAlongTheNormalComeBack) {
     const double h = 1.0 / 32, radius = 10 * h, rate = 0.1;
     const auto ball = [&](const Eigen::Vector3d& p) { return p.norm() - radius; };
     const GridPtr exact =
@@ -980,7 +898,9 @@ TEST(FastMarching, SeedsOfAStretchThatChangesAlongTheNormalComeBack) {
     const GridPtr firstOrder = g->deepCopy();
     openvdb::CoordBBox region = g->evalActiveVoxelBoundingBox();
     region.expand(2);
-    renormalize(*g, region, all, all, FmmOrder::Second, nullptr, Seeding::Lower, &before);
+    RenormalizeOptions o = within(region, &all, &all);
+    o.gradientBefore = &before;
+    renormalize(*g, o);
 
     auto was = exact->getConstAccessor(), now = g->getConstAccessor(),
          sampled = firstOrder->getConstAccessor();

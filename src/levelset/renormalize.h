@@ -10,11 +10,11 @@
 //     higher), or, in a second pass after a tear, the distance to the surface the values
 //     place (Seeding); given the gradient norms the values had before a deformation, phi
 //     over the stretch it made instead, or the second-order root where it lies more than a
-//     hundredth of a voxel from that (renormalize()). Values whose gradient (or stretch) is
-//     already unit within 1%, and values on or within two voxels of a feature one voxel thin
-//     (the surface on both sides along an axis that meets it at more than about 15 degrees;
-//     but for that cap), are kept, and so are seeds whose stencil a deformation did not
-//     change (the `moved` overload): the estimate is not idempotent where the surface
+//     hundredth of a voxel from that (RenormalizeOptions::gradientBefore). Values whose gradient
+//     (or stretch) is already unit within 1%, and values on or within two voxels of a feature one
+//     voxel thin (the surface on both sides along an axis that meets it at more than about 15
+//     degrees; but for that cap), are kept, and so are seeds whose stencil a deformation did not
+//     change (RenormalizeOptions::moved): the estimate is not idempotent where the surface
 //     curves within a voxel, and an interface seeded again and again would creep. The sign
 //     of every voxel is kept.
 //  2. every other voxel gets the upwind solution from its neighbours of its own side: the
@@ -34,13 +34,16 @@
 // band must already lie in leaves (advection activates it before sampling).
 #pragma once
 
+#include <optional>
+
 #include "levelset/interrupt.h"
 #include "levelset/vdb.h"
 #include "levelset/voxel_list.h"
 
 namespace sweepers {
 
-enum class FmmOrder { First = 1, Second = 2 };
+// The order of the upwind stencil every voxel but the seeds is solved with.
+enum class UpwindOrder { First = 1, Second = 2 };
 
 // How seeds are estimated.
 //  Lower: a seed's second-order value replaces its first-order one only downwards, after
@@ -58,7 +61,42 @@ enum class FmmOrder { First = 1, Second = 2 };
 //    tenth to a third of a voxel, more than the surface's distance does from voxel to voxel.
 enum class Seeding { Lower, Either, Interface };
 
-struct FmmStats {
+// What a renormalization recomputes, and how. The defaults renormalize the whole band.
+struct RenormalizeOptions {
+    // The voxels recomputed (index space). Unset: the whole active band, after which the
+    // whole tree is pruned (its internal nodes too); set, the tree is pruned there.
+    std::optional<openvdb::CoordBBox> region;
+    // Of the region, only the voxels also listed here (what a deformation changed, grown by
+    // the band): the rest keep their values and act as boundary. The work is that of the
+    // leaves listed and those next to them, however many more the region holds.
+    const VoxelList* only = nullptr;
+    // Only the voxels of `moved` changed since the band was last a distance (advection
+    // leaves out changes of less than a hundredth of a voxel): seeds are recomputed only
+    // where their stencil (the voxel and its face neighbours) holds a voxel of `moved`;
+    // other seeds keep their values, as boundary.
+    const VoxelList* moved = nullptr;
+    UpwindOrder order = UpwindOrder::Second;
+    Seeding seeding = Seeding::Lower;
+    // Per leaf, the norms of the gradient the values had before a deformation (with
+    // Seeding::Lower only): a seed for which it holds a value is its value divided by the
+    // stretch the deformation made there: its gradient's norm (central differences) over the
+    // norm the values had before, at its pre-image. Central differences read a distance's
+    // gradient below 1 wherever the surface curves within a few voxels, so a seed divided by
+    // its own gradient's norm grows each time it is seeded again: the surface sharpens what
+    // curves, which trilinear sampling's rounding roughly cancels, but which creeps under a
+    // sampling that does not round (advect.h, Sampling::Corrected). Where the stretch changes
+    // along the normal (a pull stretches the band more near the tool than away), phi over the
+    // stretch errs by its relative change per voxel times the squared distance: the root of
+    // the second-order model of phi along the normal (its gradient divided by the norm
+    // before, as the stretch is) takes its place where the two differ by more than a
+    // hundredth of a voxel.
+    const VoxelValues* gradientBefore = nullptr;
+    // Polled between phases and during the solve: a cancelled renormalization throws
+    // Cancelled before it writes anything back.
+    Interrupter* interrupter = nullptr;
+};
+
+struct RenormalizeStats {
     std::size_t seeds = 0;
     std::size_t marched = 0; // voxels given a distance within the band (seeds excluded)
     // Leaves of the domain: those overlapping the region and its margin (given `only`, those
@@ -66,41 +104,8 @@ struct FmmStats {
     std::size_t leaves = 0;
 };
 
-// Recomputes the distances of the voxels inside `region` (index space). The result is a
-// valid narrow band of the grid's half-width there; the tree is pruned afterwards.
-// `interrupter` is polled between phases and during the solve; a cancelled
-// renormalization throws Cancelled before it writes anything back.
-FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region,
-                     FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
-// The same, for the voxels of `region` that are also in `only` (what a deformation changed,
-// grown by the band): the rest keep their values and act as boundary. The work is that of
-// the leaves `only` lists and those next to them, however many more the region holds.
-FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
-                     FmmOrder order = FmmOrder::Second, Interrupter* interrupter = nullptr);
-
-// The same, where only the voxels of `moved` changed since the band was last a distance
-// (advection leaves out changes of less than a hundredth of a voxel): seeds are recomputed
-// only where their stencil (the voxel and its face neighbours) holds a voxel of `moved`;
-// other seeds keep their values, as boundary.
-//
-// With `gradientBefore` (Seeding::Lower only), a seed for which it holds a value is its
-// value divided by the stretch the deformation made there: its gradient's norm (central
-// differences) over the norm the values had before, at its pre-image. Central differences
-// read a distance's gradient below 1 wherever the surface curves within a few voxels, so a
-// seed divided by its own gradient's norm grows each time it is seeded again: the surface
-// sharpens what curves, which trilinear sampling's rounding roughly cancels, but which
-// creeps under a sampling that does not round (advect.h, Sampling::Corrected). Where the
-// stretch changes along the normal (a pull stretches the band more near the tool than
-// away), phi over the stretch errs by its relative change per voxel times the squared
-// distance: the root of the second-order model of phi along the normal (its gradient
-// divided by the norm before, as the stretch is) takes its place where the two differ by
-// more than a hundredth of a voxel.
-FmmStats renormalize(Grid& grid, const openvdb::CoordBBox& region, const VoxelList& only,
-                     const VoxelList& moved, FmmOrder order = FmmOrder::Second,
-                     Interrupter* interrupter = nullptr, Seeding seeding = Seeding::Lower,
-                     const VoxelValues* gradientBefore = nullptr);
-// Renormalizes the whole active band.
-FmmStats renormalizeAll(Grid& grid, FmmOrder order = FmmOrder::Second,
-                        Interrupter* interrupter = nullptr);
+// Recomputes the distances of the voxels the options name. The result is a valid narrow band
+// of the grid's half-width there.
+RenormalizeStats renormalize(Grid& grid, const RenormalizeOptions& options = {});
 
 } // namespace sweepers
