@@ -124,14 +124,10 @@ void requireNoActiveSubmission(const StudyPlan& plan) {
                              list + ", then submit again");
 }
 
-SlurmSubmission submitStudy(const StudyPlan& plan, const std::vector<std::size_t>& pending,
-                            const SlurmOptions& options) {
+SlurmScripts slurmScripts(const StudyPlan& plan, const std::vector<std::size_t>& pending,
+                          const SlurmOptions& options, const std::string& program) {
     const std::string dir = slurmDir(plan), logs = dir + "/logs";
-    std::error_code ec;
-    std::filesystem::create_directories(logs, ec);
-    if (ec) throw std::runtime_error(logs + ": cannot create it (" + ec.message() + ")");
-    const std::string program = thisProgram();
-
+    SlurmScripts out;
     // Tiers of one voxel size each, coarsest first; each asks for its largest run.
     std::map<double, std::vector<std::size_t>, std::greater<>> tiers;
     int memoryAll = 0, minutesAll = 0;
@@ -161,7 +157,7 @@ SlurmSubmission submitStudy(const StudyPlan& plan, const std::vector<std::size_t
     runs << " )\n"
          << "exec " << shellWord(program) << " study -o " << shellWord(plan.dir)
          << " --run \"${runs[$SLURM_ARRAY_TASK_ID]}\" --threads \"${SLURM_CPUS_PER_TASK:-1}\"\n";
-    writeTextAtomically(dir + "/runs.sbatch", runs.str());
+    out.runs = runs.str();
 
     std::ostringstream merge;
     merge << "#!/bin/bash\n"
@@ -175,28 +171,48 @@ SlurmSubmission submitStudy(const StudyPlan& plan, const std::vector<std::size_t
           << "#SBATCH --time=" << kMergeMinutes << "\n"
           << commonDirectives(options) << "exec " << shellWord(program) << " study -o "
           << shellWord(plan.dir) << " --merge\n";
-    writeTextAtomically(dir + "/merge.sbatch", merge.str());
+    out.merge = merge.str();
+
+    for (const auto& [h, indices] : tiers) {
+        SlurmScripts::Array array;
+        array.voxelSize = h;
+        array.runs = indices;
+        for (const std::size_t i : indices) {
+            array.memoryMb = std::max(array.memoryMb, memoryRequestMb(plan.runs[i]));
+            array.minutes = std::max(array.minutes, timeRequestMinutes(plan.runs[i]));
+        }
+        array.args = {"--array=" + arraySpec(indices, options.maxRunning),
+                      "--mem=" + std::to_string(array.memoryMb) + "M"};
+        if (array.minutes > 0) array.args.push_back("--time=" + std::to_string(array.minutes));
+        out.arrays.push_back(array);
+    }
+    return out;
+}
+
+SlurmSubmission submitStudy(const StudyPlan& plan, const std::vector<std::size_t>& pending,
+                            const SlurmOptions& options) {
+    const std::string dir = slurmDir(plan), logs = dir + "/logs";
+    std::error_code ec;
+    std::filesystem::create_directories(logs, ec);
+    if (ec) throw std::runtime_error(logs + ": cannot create it (" + ec.message() + ")");
+    const SlurmScripts scripts = slurmScripts(plan, pending, options, thisProgram());
+    writeTextAtomically(dir + "/runs.sbatch", scripts.runs);
+    writeTextAtomically(dir + "/merge.sbatch", scripts.merge);
 
     SlurmSubmission out;
     json arrays = json::array();
-    for (const auto& [h, indices] : tiers) {
-        int memory = 0, minutes = 0;
-        json ids = json::array();
-        for (const std::size_t i : indices) {
-            memory = std::max(memory, memoryRequestMb(plan.runs[i]));
-            minutes = std::max(minutes, timeRequestMinutes(plan.runs[i]));
-            ids.push_back(plan.runs[i].id);
-        }
-        std::vector<std::string> args = {"--array=" + arraySpec(indices, options.maxRunning),
-                                         "--mem=" + std::to_string(memory) + "M"};
-        if (minutes > 0) args.push_back("--time=" + std::to_string(minutes));
+    for (const SlurmScripts::Array& array : scripts.arrays) {
+        std::vector<std::string> args = array.args;
         if (!out.arrays.empty()) args.push_back("--dependency=afterany:" + out.arrays.back());
         args.push_back(dir + "/runs.sbatch");
         out.arrays.push_back(submit(args));
+        json ids = json::array();
+        for (const std::size_t i : array.runs)
+            ids.push_back(plan.runs[i].id);
         arrays.push_back({{"job", out.arrays.back()},
-                          {"voxel_size", h},
-                          {"mem_mb", memory},
-                          {"time_minutes", minutes},
+                          {"voxel_size", array.voxelSize},
+                          {"mem_mb", array.memoryMb},
+                          {"time_minutes", array.minutes},
                           {"runs", ids}});
     }
     std::string after = "afterany";

@@ -33,6 +33,25 @@ struct SlurmSubmission {
 // running (running its runs twice would race for their results).
 void requireNoActiveSubmission(const StudyPlan& plan);
 
+// What a submission writes and asks sbatch for, made from the plan alone (no cluster, no
+// file): runs.sbatch, merge.sbatch, and one job array per voxel size, coarsest first, with its
+// runs (indices into plan.runs) and the sbatch arguments that ask for their largest memory
+// and time. `program` is the sweepers-cli the jobs run.
+struct SlurmScripts {
+    std::string runs, merge;
+    struct Array {
+        double voxelSize = 0.0;
+        std::vector<std::size_t> runs;
+        int memoryMb = 0, minutes = 0; // minutes 0: the partition's limit
+        // --array, --mem and --time (the dependency on the array before is added when
+        // submitted: it names that array's job id).
+        std::vector<std::string> args;
+    };
+    std::vector<Array> arrays;
+};
+SlurmScripts slurmScripts(const StudyPlan& plan, const std::vector<std::size_t>& pending,
+                          const SlurmOptions& options, const std::string& program);
+
 // Writes DIR/slurm/runs.sbatch and DIR/slurm/merge.sbatch for the `pending` runs (indices
 // into plan.runs) and submits them; records the job ids in DIR/slurm/jobs.json.
 SlurmSubmission submitStudy(const StudyPlan& plan, const std::vector<std::size_t>& pending,
