@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "levelset/resample.h"
+#include "levelset/cell_interpolation.h"
 #include "levelset/local_tree.h"
 #include "levelset/monotone_cubic.h"
 #include "levelset/parallel.h"
@@ -29,66 +30,6 @@ constexpr double kCorrectedReach = 2.5;
 // more on a pinch's hole wall, at a pulled tip), and such a seed, divided by its own
 // gradient's norm, took a value the eikonal test refused.
 constexpr double kSeedValues = kCorrectedReach;
-
-// Trilinear interpolation of a cell's corner values at offset uvw inside it, in single
-// precision (the values are floats; OpenVDB's BoxSampler turns every product into a double
-// and back, in the innermost loop of sampling).
-float trilinearIn(const float (&c)[2][2][2], const openvdb::Vec3d& uvw) {
-    const float u = float(uvw[0]), v = float(uvw[1]), w = float(uvw[2]);
-    const auto lerp = [](float a, float b, float t) { return a + (b - a) * t; };
-    return lerp(lerp(lerp(c[0][0][0], c[0][0][1], w), lerp(c[0][1][0], c[0][1][1], w), v),
-                lerp(lerp(c[1][0][0], c[1][0][1], w), lerp(c[1][1][0], c[1][1][1], w), v), u);
-}
-
-// Sampling::Corrected at offset uvw in a cell: the trilinear value less half of each axis's
-// second differences, interpolated from the cell's corners like the values, times t (1 - t)
-// on that axis. `at(i, j, k)` reads the value at offset (i, j, k) from the cell's lowest
-// corner, each from -1 to 2 (the corners and one voxel beyond them along each axis). Within
-// `reach` of the surface, `slope` (when given) receives the central differences at the
-// corners, interpolated likewise: those of the trilinear values one voxel either way.
-template <typename At>
-float correctedIn(const At& at, const openvdb::Vec3d& uvw, float reach, float* slope = nullptr) {
-    float c[2][2][2];
-    for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 2; ++j)
-            for (int k = 0; k < 2; ++k)
-                c[i][j][k] = at(i, j, k);
-    const float linear = trilinearIn(c, uvw);
-    if (!(std::abs(linear) < reach)) return linear;
-    float d1[3][2][2][2], d2[3][2][2][2];
-    for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 2; ++j)
-            for (int k = 0; k < 2; ++k) {
-                const int o = 1 - 2 * i, p = 1 - 2 * j, q = 1 - 2 * k; // into the cell
-                const float twice = 2.0f * c[i][j][k];
-                const float in[3] = {c[1 - i][j][k], c[i][1 - j][k], c[i][j][1 - k]};
-                const float out[3] = {at(i - o, j, k), at(i, j - p, k), at(i, j, k - q)};
-                const int into[3] = {o, p, q};
-                for (int a = 0; a < 3; ++a) {
-                    if (slope) d1[a][i][j][k] = 0.5f * float(into[a]) * (in[a] - out[a]);
-                    d2[a][i][j][k] = in[a] - twice + out[a];
-                }
-            }
-    float correction = 0.0f;
-    for (int a = 0; a < 3; ++a) {
-        const float t = float(uvw[a]);
-        correction += t * (1.0f - t) * trilinearIn(d2[a], uvw);
-        if (slope) slope[a] = trilinearIn(d1[a], uvw);
-    }
-    return linear - 0.5f * correction;
-}
-
-// The cell (its lowest corner) holding index-space point p: the floor on each axis, as a
-// truncation and a compare. std::floor is a call into libm in the baseline x86-64 build, on
-// every sampled voxel; the integers are the same for any point
-// within a grid's coordinates.
-openvdb::Coord cellOf(const openvdb::Vec3d& p) {
-    const auto down = [](double x) {
-        const int i = int(x);
-        return i - int(x < double(i));
-    };
-    return openvdb::Coord(down(p[0]), down(p[1]), down(p[2]));
-}
 
 // The source values around one leaf, in a dense block: a leaf's pre-images of a drag lie
 // within a voxel or two of it, and their trilinear samples read the block by strides,
@@ -134,8 +75,10 @@ class SourceBlock {
                d.z() < kDim - 2;
     }
     // Sampling::Corrected in the cell with lowest corner ijk (held with a voxel around it).
-    float corrected(const openvdb::Coord& ijk, const openvdb::Vec3d& uvw, float reach,
-                    float* slope = nullptr) const {
+    // Kept out of the sampling loop: inlined there, its many live values crowd the loop's
+    // registers, and the loop as a whole runs slower.
+    __attribute__((noinline)) float corrected(const openvdb::Coord& ijk, const openvdb::Vec3d& uvw,
+                                              float reach, float* slope = nullptr) const {
         const std::size_t o = index(ijk);
         return correctedIn(
             [&](int i, int j, int k) {
@@ -226,38 +169,6 @@ void SampleSource::copyAlso(const std::vector<LeafNode*>& leaves, const Staged& 
         copies_->tree().addLeaf(leaf);
 }
 
-// When the cell lies inside one leaf (343 cells in 512) its eight corners are read from that
-// leaf's buffer, after a single lookup instead of eight.
-float SampleSource::Accessor::trilinear(const openvdb::Vec3d& p) const {
-    const openvdb::Coord ijk = cellOf(p);
-    const openvdb::Vec3d uvw = p - ijk.asVec3d();
-    float data[2][2][2];
-    const LeafNode* leaf = nullptr;
-    if ((ijk[0] & 7) < 7 && (ijk[1] & 7) < 7 && (ijk[2] & 7) < 7) {
-        leaf = copy(ijk);
-        if (!leaf) leaf = live_.probeConstLeaf(ijk);
-    }
-    if (leaf) {
-        const openvdb::Index o = LeafNode::coordToOffset(ijk);
-        for (int i = 0; i < 2; ++i)
-            for (int j = 0; j < 2; ++j)
-                for (int k = 0; k < 2; ++k)
-                    data[i][j][k] = leaf->getValue(o + i * 64 + j * 8 + k);
-    } else {
-        for (int i = 0; i < 2; ++i)
-            for (int j = 0; j < 2; ++j)
-                for (int k = 0; k < 2; ++k)
-                    data[i][j][k] = getValue(ijk.offsetBy(i, j, k));
-    }
-    return trilinearIn(data, uvw);
-}
-
-float SampleSource::Accessor::corrected(const openvdb::Vec3d& p, float reach, float* slope) const {
-    const openvdb::Coord ijk = cellOf(p);
-    return correctedIn([&](int i, int j, int k) { return getValue(ijk.offsetBy(i, j, k)); },
-                       p - ijk.asVec3d(), reach, slope);
-}
-
 void farWithSigns(LeafNode& leaf, float far, const Grid::ConstAccessor& live) {
     for (auto it = leaf.beginValueAll(); it; ++it)
         it.setValue(live.getValue(it.getCoord()) < 0.0f ? -far : far);
@@ -285,7 +196,11 @@ double filledFromValue(const SampleSource& source, const Grid& grid, const StepD
 std::size_t Resampler::run(Grid& grid, const std::vector<LeafNode*>& leaves,
                            const SampleSource& source, const ResamplePlan& plan,
                            const ResampleOutput& out) {
+    // Read once: the loops below write floats, which the compiler must otherwise assume may
+    // change the plan's and output's numbers.
     const openvdb::CoordBBox& box = plan.box;
+    const bool sourceIsGrid = plan.sourceIsGrid;
+    const float nudge = out.nudge;
     const Sampling sampling = plan.sampling;
     const StepDeformation* seg = plan.tearsOrFills;
     const double tornWindow = plan.tornWindow;
@@ -353,7 +268,7 @@ std::size_t Resampler::run(Grid& grid, const std::vector<LeafNode*>& leaves,
                 float v = old;
                 float slope[3] = {std::numeric_limits<float>::quiet_NaN(), 0.0f, 0.0f};
                 bool madeDistance = false; // by the fill of what has no pre-image
-                if (y != x || !plan.sourceIsGrid) {
+                if (y != x || !sourceIsGrid) {
                     const auto sample = [&](const Eigen::Vector3d& at, float* slopeAt = nullptr) {
                         const openvdb::Vec3d p = place.toIndex(toVdb(at));
                         if (sampling == Sampling::MonotoneCubic)
@@ -421,7 +336,7 @@ std::size_t Resampler::run(Grid& grid, const std::vector<LeafNode*>& leaves,
                              : acc.isValueOn(leaf.offsetToGlobalCoord(openvdb::Index(pos))));
                 const leafwords::Word bit = leafwords::Word(1) << (pos & 63);
                 if (v != old || joined) changedWords[l][std::size_t(pos >> 6)] |= bit;
-                if (std::abs(v - old) > out.nudge || joined)
+                if (std::abs(v - old) > nudge || joined)
                     movedWords[l][std::size_t(pos >> 6)] |= bit;
                 written[pos] = v;
             }
