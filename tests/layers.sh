@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # The layers of src/ only depend downwards:
-#   core < tools < deform < levelset < mesh < sculpt < study < io < app, cli < python
+#   core < vdb < tools < deform < levelset < mesh < sculpt < study < io < app, cli < python
 # A file may include headers of its own layer and of layers below it; app and cli do not
 # include each other; the window-free part of app (app_core) includes no GL, GLFW window
 # or ImGui code. CMake links one library per layer in the same order.
@@ -9,8 +9,9 @@ set -euo pipefail
 src=$(cd "$(dirname "$0")/../src" && pwd)
 rank() {
   case $1 in
-    core) echo 0 ;; tools) echo 1 ;; deform) echo 2 ;; levelset) echo 3 ;; mesh) echo 4 ;;
-    sculpt) echo 5 ;; study) echo 6 ;; io) echo 7 ;; app | cli) echo 8 ;; python) echo 9 ;;
+    core) echo 0 ;; vdb) echo 1 ;; tools) echo 2 ;; deform) echo 3 ;; levelset) echo 4 ;;
+    mesh) echo 5 ;; sculpt) echo 6 ;; study) echo 7 ;; io) echo 8 ;; app | cli) echo 9 ;;
+    python) echo 10 ;;
     *) echo "unknown layer $1" >&2; exit 2 ;;
   esac
 }

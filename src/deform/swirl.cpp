@@ -45,7 +45,8 @@ SwirlSegment::SwirlSegment(const SwirlSpec& spec) : spec_(spec) {
 std::optional<MotionLog> SwirlSegment::stepLog(int k, const Eigen::Vector3d& p) const {
     const Eigen::Vector3d c = ringCentre(k + 1);
     const Eigen::Vector3d d = p - c;
-    if (d.squaredNorm() >= reach_ * reach_) return std::nullopt;
+    const double dist2 = d.squaredNorm();
+    if (dist2 >= reach_ * reach_) return std::nullopt;
     const double r = spec_.radius;
     Twist sum;
     if (spec_.ring == SwirlRing::Discrete) {
@@ -68,8 +69,9 @@ std::optional<MotionLog> SwirlSegment::stepLog(int k, const Eigen::Vector3d& p) 
         const double lambda = spec_.lambdaOverRadius * r;
         const double l2 = lambda * lambda;
         const Eigen::Vector3d eta = 2.0 * z_.cross(d);
-        const double a = d.squaredNorm() + l2 + r * r;
-        const double b = 2.0 * l2 * l2 * r / std::pow(a * a - r * r * eta.squaredNorm(), 1.5);
+        const double eta2 = eta.squaredNorm();
+        const double a = dist2 + l2 + r * r;
+        const double b = 2.0 * l2 * l2 * r / std::pow(a * a - r * r * eta2, 1.5);
         // The field is cut off at the bounding sphere through its stream function, not by
         // itself: cut off by itself, it would pour clay through the sphere, at any voxel size.
         // The field is axisymmetric about z through c with no swirl component, so it is the
@@ -78,13 +80,13 @@ std::optional<MotionLog> SwirlSegment::stepLog(int k, const Eigen::Vector3d& p) 
         // The curl of chi times that potential, chi going smoothly from 1 to 0 between half
         // the reach and the reach, is the field times chi plus grad chi x the potential:
         // divergence-free again.
-        const double dist2 = d.squaredNorm(), dist = std::sqrt(dist2);
+        const double dist = std::sqrt(dist2);
         const double chi = falloffMu(dist - inner_, reach_ - inner_);
         Eigen::Vector3d translation = chi * theta_ * b * (c.cross(eta) + a * z_);
         if (dist > inner_) {
             const double zeta = z_.dot(d);
             // psi / rho^2, written without the cancellation of a / sqrt(...) - 1 near the axis.
-            const double root = std::sqrt(std::max(0.0, 1.0 - r * r * eta.squaredNorm() / (a * a)));
+            const double root = std::sqrt(std::max(0.0, 1.0 - r * r * eta2 / (a * a)));
             const double psiOverRho2 = 2.0 * l2 * l2 * r / (a * a * root * (1.0 + root));
             const double chiSlope = falloffMuDerivative(dist - inner_, reach_ - inner_);
             translation += theta_ * chiSlope * psiOverRho2 / dist * (dist2 * z_ - zeta * d);

@@ -12,8 +12,8 @@
 #include <vector>
 
 #include "io/atomic_file.h"
-#include "levelset/vdb.h"
 #include "sculpt/film.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -22,7 +22,7 @@
 
 #include "io/stroke_script.h"
 #include "levelset/interrupt.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -20,7 +20,7 @@
 #include "io/stroke_script.h"
 #include "io/study_files.h"
 #include "io/vdb_file.h"
-#include "levelset/parallel.h"
+#include "vdb/parallel.h"
 
 namespace sweepers {
 

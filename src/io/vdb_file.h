@@ -13,7 +13,7 @@
 
 #include "io/atomic_file.h"
 #include "io/input_file.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

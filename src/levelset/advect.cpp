@@ -4,10 +4,10 @@
 #include "levelset/band.h"
 #include "levelset/band_growth.h"
 #include "levelset/dilate.h"
-#include "levelset/leaf_words.h"
-#include "levelset/local_tree.h"
-#include "levelset/parallel.h"
 #include "levelset/renormalize.h"
+#include "vdb/leaf_words.h"
+#include "vdb/local_tree.h"
+#include "vdb/parallel.h"
 
 #include <algorithm>
 #include <array>

@@ -27,7 +27,7 @@
 #include "levelset/interrupt.h"
 #include "levelset/renormalize.h"
 #include "levelset/resample.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 
@@ -63,7 +63,7 @@ struct AdvectStats {
     double growSeconds = 0.0, sampleSeconds = 0.0, renormalizeSeconds = 0.0;
     // Each phase of SegmentAdvector, in the order of kAdvectPhases (the first four make band
     // growth, the next two sampling, the seventh renormalization): its wall time, and the
-    // time one thread worked in it while the others waited (levelset/parallel.h), what more
+    // time one thread worked in it while the others waited (vdb/parallel.h), what more
     // cores cannot shorten.
     struct PhaseTime {
         double seconds = 0.0, serialSeconds = 0.0;

@@ -10,8 +10,8 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
 
-#include "levelset/leaf_words.h"
 #include "levelset/stencils.h"
+#include "vdb/leaf_words.h"
 
 namespace sweepers {
 

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "core/box.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -2,8 +2,8 @@
 #include "levelset/band_growth.h"
 #include "levelset/band.h"
 #include "levelset/dilate.h"
-#include "levelset/parallel.h"
 #include "levelset/resample.h"
+#include "vdb/parallel.h"
 
 #include <algorithm>
 #include <atomic>

@@ -10,8 +10,8 @@
 #include "core/box.h"
 #include "deform/step_deformation.h"
 #include "levelset/resample.h"
-#include "levelset/vdb.h"
-#include "levelset/voxel_list.h"
+#include "vdb/vdb.h"
+#include "vdb/voxel_list.h"
 
 namespace sweepers {
 

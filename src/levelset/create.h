@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "levelset/interrupt.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

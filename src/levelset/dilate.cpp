@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "levelset/dilate.h"
-#include "levelset/parallel.h"
+#include "vdb/parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -12,7 +12,7 @@
 #include <tbb/parallel_for.h>
 
 #include "levelset/leaf_box.h"
-#include "levelset/leaf_words.h"
+#include "vdb/leaf_words.h"
 
 namespace sweepers {
 

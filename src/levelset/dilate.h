@@ -14,7 +14,7 @@
 
 #include <openvdb/openvdb.h>
 
-#include "levelset/voxel_list.h"
+#include "vdb/voxel_list.h"
 
 namespace sweepers {
 

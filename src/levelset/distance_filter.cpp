@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "levelset/parallel.h"
+#include "vdb/parallel.h"
 
 namespace sweepers {
 

@@ -37,9 +37,9 @@
 #include <unordered_map>
 #include <vector>
 
-#include "levelset/leaf_words.h"
-#include "levelset/vdb.h"
-#include "levelset/voxel_list.h"
+#include "vdb/leaf_words.h"
+#include "vdb/vdb.h"
+#include "vdb/voxel_list.h"
 
 namespace sweepers {
 

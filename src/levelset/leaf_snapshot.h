@@ -6,7 +6,7 @@
 #include <memory>
 #include <unordered_map>
 
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

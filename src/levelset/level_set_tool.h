@@ -22,8 +22,8 @@
 #include <string>
 
 #include "levelset/interrupt.h"
-#include "levelset/vdb.h"
 #include "tools/tool_shape.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -3,7 +3,7 @@
 #pragma once
 
 #include "core/box.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -4,7 +4,7 @@
 #pragma once
 
 #include "core/monotone_cubic.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -7,7 +7,7 @@
 #include <array>
 #include <cstddef>
 
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -23,7 +23,7 @@
 #include <string>
 
 #include "core/box.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

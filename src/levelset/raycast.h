@@ -5,7 +5,7 @@
 
 #include <optional>
 
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "levelset/renormalize.h"
-#include "levelset/parallel.h"
+#include "vdb/parallel.h"
 
 #include <algorithm>
 #include <array>
@@ -20,11 +20,11 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "levelset/leaf_words.h"
 #include "levelset/linear_surface.h"
-#include "levelset/local_tree.h"
 #include "levelset/upwind_domain.h"
 #include "levelset/upwind_row.h"
+#include "vdb/leaf_words.h"
+#include "vdb/local_tree.h"
 
 namespace sweepers {
 

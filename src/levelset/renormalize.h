@@ -37,8 +37,8 @@
 #include <optional>
 
 #include "levelset/interrupt.h"
-#include "levelset/vdb.h"
-#include "levelset/voxel_list.h"
+#include "vdb/vdb.h"
+#include "vdb/voxel_list.h"
 
 namespace sweepers {
 

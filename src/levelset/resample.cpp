@@ -1,9 +1,9 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "levelset/resample.h"
 #include "levelset/cell_interpolation.h"
-#include "levelset/local_tree.h"
 #include "levelset/monotone_cubic.h"
-#include "levelset/parallel.h"
+#include "vdb/local_tree.h"
+#include "vdb/parallel.h"
 
 #include <algorithm>
 #include <array>

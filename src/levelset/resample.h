@@ -16,9 +16,9 @@
 #include "deform/step_deformation.h"
 #include "levelset/cell_interpolation.h"
 #include "levelset/interrupt.h"
-#include "levelset/leaf_words.h"
-#include "levelset/vdb.h"
-#include "levelset/voxel_list.h"
+#include "vdb/leaf_words.h"
+#include "vdb/vdb.h"
+#include "vdb/voxel_list.h"
 
 namespace sweepers {
 

@@ -13,8 +13,8 @@
 #include "core/stopwatch.h"
 #include "levelset/dilate.h"
 #include "levelset/padded_leaf.h"
-#include "levelset/parallel.h"
 #include "levelset/renormalize.h"
+#include "vdb/parallel.h"
 
 namespace sweepers {
 

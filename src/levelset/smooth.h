@@ -38,8 +38,8 @@
 
 #include "levelset/distance_filter.h"
 #include "levelset/interrupt.h"
-#include "levelset/vdb.h"
-#include "levelset/voxel_list.h"
+#include "vdb/vdb.h"
+#include "vdb/voxel_list.h"
 
 namespace sweepers {
 

@@ -3,7 +3,7 @@
 // block, the corners of a voxel cube, the central-difference gradient.
 #pragma once
 
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

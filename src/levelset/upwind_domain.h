@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "levelset/leaf_box.h"
-#include "levelset/leaf_words.h"
-#include "levelset/local_tree.h"
-#include "levelset/vdb.h"
-#include "levelset/voxel_list.h"
+#include "vdb/leaf_words.h"
+#include "vdb/local_tree.h"
+#include "vdb/vdb.h"
+#include "vdb/voxel_list.h"
 
 namespace sweepers::upwind {
 

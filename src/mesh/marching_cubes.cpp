@@ -12,11 +12,11 @@
 #include <tbb/parallel_sort.h>
 #include <xxhash.h>
 
-#include "levelset/leaf_words.h"
-#include "levelset/local_tree.h"
-#include "levelset/parallel.h"
 #include "levelset/stencils.h"
 #include "mesh/mc_table.h"
+#include "vdb/leaf_words.h"
+#include "vdb/local_tree.h"
+#include "vdb/parallel.h"
 
 namespace sweepers {
 

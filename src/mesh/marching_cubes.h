@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "levelset/interrupt.h"
-#include "levelset/vdb.h"
 #include "mesh/triangle_mesh.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -22,8 +22,8 @@
 #include "io/study_files.h"
 #include "io/study_plan.h"
 #include "io/vdb_file.h"
-#include "levelset/parallel.h"
 #include "python/shape.h"
+#include "vdb/parallel.h"
 
 namespace py = pybind11;
 using namespace sweepers;

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 #include "sculpt/sculptor.h"
 
-#include "levelset/parallel.h"
+#include "vdb/parallel.h"
 
 #include "core/stopwatch.h"
 

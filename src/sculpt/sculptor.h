@@ -35,7 +35,7 @@ struct SegmentReport {
     // Work outside the advection's phases that kept its own serial clock (a smooth dab):
     // its wall time, and its time on one thread while the others waited.
     double otherSeconds = 0.0, otherSerialSeconds = 0.0;
-    // The segment's serial time (levelset/parallel.h): each phase's, what runs around the
+    // The segment's serial time (vdb/parallel.h): each phase's, what runs around the
     // phases on one thread, and the re-meshing's.
     double serialSeconds() const {
         double phases = otherSeconds, serial = meshSerialSeconds + otherSerialSeconds;

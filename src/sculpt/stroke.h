@@ -36,7 +36,7 @@
 #include "deform/swept_fluid.h"
 #include "deform/swirl.h"
 #include "levelset/smooth.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -15,7 +15,7 @@
 #include <Eigen/Core>
 
 #include "deform/step_deformation.h"
-#include "levelset/vdb.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

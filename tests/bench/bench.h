@@ -9,8 +9,8 @@
 
 #include <benchmark/benchmark.h>
 
-#include "levelset/vdb.h"
 #include "mesh/triangle_mesh.h"
+#include "vdb/vdb.h"
 
 namespace sweepers::bench {
 

@@ -46,7 +46,7 @@ void addSegmentCounters(benchmark::State& state, const std::vector<SegmentReport
         state.counters[std::string(name) + "_p95_ms"] = percentile(*v, 0.95);
     }
     // The share of the segments' time during which one thread worked and the others waited
-    // (levelset/parallel.h): at one thread, Amdahl's bound on what more cores can give.
+    // (vdb/parallel.h): at one thread, Amdahl's bound on what more cores can give.
     state.counters["serial_fraction"] = allTime > 0.0 ? allSerial / allTime : 0.0;
     // Where it is: each phase's serial time, mean per segment.
     for (std::size_t k = 0; k < kAdvectPhases.size(); ++k) {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// levelset/leaf_words.h: a leaf's voxel sets as eight 64-bit words.
+// vdb/leaf_words.h: a leaf's voxel sets as eight 64-bit words.
 #include <algorithm>
 #include <limits>
 #include <random>
@@ -7,7 +7,7 @@
 
 #include <gtest/gtest.h>
 
-#include "levelset/leaf_words.h"
+#include "vdb/leaf_words.h"
 
 using namespace sweepers;
 

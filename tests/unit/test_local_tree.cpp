@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: Apache-2.0
-// levelset/local_tree.h: a leaf's signs flooded as OpenVDB floods them, and trees freed on
+// vdb/local_tree.h: a leaf's signs flooded as OpenVDB floods them, and trees freed on
 // the calling thread.
 #include <cstring>
 #include <limits>
@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 #include <openvdb/tools/SignedFloodFill.h>
 
-#include "levelset/local_tree.h"
+#include "vdb/local_tree.h"
 
 using namespace sweepers;
 

@@ -8,7 +8,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
-#include "levelset/parallel.h"
+#include "vdb/parallel.h"
 
 using namespace sweepers;
 

@@ -17,10 +17,10 @@
 
 #include "grids.h"
 #include "levelset/band.h"
-#include "levelset/leaf_words.h"
 #include "levelset/peer_check.h"
 #include "levelset/renormalize.h"
 #include "levelset/upwind_row.h"
+#include "vdb/leaf_words.h"
 
 using namespace sweepers;
 using sweepers::test::gridFromSdf;

@@ -10,7 +10,7 @@
 
 #include <openvdb/math/Coord.h>
 
-#include "levelset/leaf_words.h"
+#include "vdb/leaf_words.h"
 
 namespace sweepers {
 

@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 #include <openvdb/openvdb.h>
 
-#include "levelset/vdb_instances.h"
+#include "vdb/vdb_instances.h"
 
 namespace sweepers {
 

@@ -20,9 +20,9 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "levelset/leaf_words.h"
-#include "levelset/parallel.h"
-#include "levelset/vdb.h"
+#include "vdb/leaf_words.h"
+#include "vdb/parallel.h"
+#include "vdb/vdb.h"
 
 namespace sweepers {
 

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The one instantiation of the MaskTree grid classes declared extern in vdb_instances.h (a
 // source file per grid type, so that they compile in parallel).
-#include "levelset/vdb_instances.h"
+#include "vdb/vdb_instances.h"
 
 template class openvdb::tree::Tree<openvdb::MaskTree::RootNodeType>;
 template class openvdb::Grid<openvdb::MaskTree>;
