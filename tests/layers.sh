@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: Apache-2.0
 # The layers of src/ only depend downwards:
-#   core < vdb < tools < deform < levelset < mesh < sculpt < study < io < app, cli < python
+#   core < vdb < tools < deform < levelset < mesh < sculpt < study < io < document < app, cli
+#   < python
 # A file may include headers of its own layer and of layers below it; app and cli do not
 # include each other; the window-free part of app (app_core) includes no GL, GLFW window
 # or ImGui code. CMake links one library per layer in the same order.
@@ -10,8 +11,8 @@ src=$(cd "$(dirname "$0")/../src" && pwd)
 rank() {
   case $1 in
     core) echo 0 ;; vdb) echo 1 ;; tools) echo 2 ;; deform) echo 3 ;; levelset) echo 4 ;;
-    mesh) echo 5 ;; sculpt) echo 6 ;; study) echo 7 ;; io) echo 8 ;; app | cli) echo 9 ;;
-    python) echo 10 ;;
+    mesh) echo 5 ;; sculpt) echo 6 ;; study) echo 7 ;; io) echo 8 ;; document) echo 9 ;;
+    app | cli) echo 10 ;; python) echo 11 ;;
     *) echo "unknown layer $1" >&2; exit 2 ;;
   esac
 }
@@ -51,5 +52,11 @@ for f in "$src"/app/*; do
   fi
 done
 echo "layers: $checked files of app/ checked for window code"
+# The Python module works on the document, not on the modeler: it includes no app/ header
+# (CMake links it to the document's library, not to app_core).
+if grep -n '#include "app/' "$src"/python/*; then
+  echo "layers: src/python includes the modeler's code"
+  bad=1
+fi
 [ "$bad" -eq 0 ] && echo "layers: every include points down"
 exit "$bad"

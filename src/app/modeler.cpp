@@ -26,7 +26,6 @@
 #include <imgui.h>
 #include <stb_image_write.h>
 
-#include "app/document.h"
 #include "app/gl_renderer.h"
 #include "app/input_replay.h"
 #include "app/sculpt_controller.h"
@@ -35,6 +34,7 @@
 #include "core/format.h"
 #include "core/statistics.h"
 #include "core/stopwatch.h"
+#include "document/document.h"
 #include "io/atomic_file.h"
 #include "io/mesh_file.h"
 #include "io/vdb_file.h"

@@ -19,9 +19,9 @@
 #include <glm/glm.hpp>
 
 #include "app/camera.h"
-#include "app/document.h"
 #include "app/input_replay.h"
 #include "core/stopwatch.h"
+#include "document/document.h"
 #include "levelset/interrupt.h"
 
 namespace sweepers {

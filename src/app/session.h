@@ -18,7 +18,7 @@
 #include <thread>
 #include <vector>
 
-#include "app/document.h"
+#include "document/document.h"
 #include "io/session_journal.h"
 
 namespace sweepers {

@@ -9,8 +9,8 @@
 #include <memory>
 #include <string>
 
-#include "app/document.h"
 #include "core/stopwatch.h"
+#include "document/document.h"
 #include "levelset/interrupt.h"
 #include "sculpt/film.h"
 

@@ -11,7 +11,7 @@
 #include <thread>
 #include <vector>
 
-#include "app/document.h"
+#include "document/document.h"
 #include "io/stroke_script.h"
 #include "levelset/measure.h"
 #include "mesh/triangle_mesh.h"

@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <exception>
 
-#include "app/document.h"
 #include "app/sculpt_controller.h"
+#include "document/document.h"
 
 int main(int argc, char** argv) {
     using namespace sweepers;

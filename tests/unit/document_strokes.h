@@ -2,7 +2,7 @@
 // Strokes a test makes on a Document as the modeler's drags make them.
 #pragma once
 
-#include "app/document.h"
+#include "document/document.h"
 
 namespace sweepers::test {
 

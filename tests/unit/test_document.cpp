@@ -3,7 +3,7 @@
 // picking the surface.
 #include <gtest/gtest.h>
 
-#include "app/document.h"
+#include "document/document.h"
 #include "document_strokes.h"
 #include "grids.h"
 #include "io/mesh_file.h"

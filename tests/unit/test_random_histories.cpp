@@ -22,10 +22,10 @@
 #include <tbb/global_control.h>
 #include <tbb/task_arena.h>
 
-#include "app/document.h"
 #include "app/sculpt_controller.h"
 #include "app/session.h"
 #include "coarse.h"
+#include "document/document.h"
 #include "grids.h"
 #include "io/start_grid.h"
 #include "io/stroke_script.h"

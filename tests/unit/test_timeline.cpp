@@ -2,8 +2,8 @@
 // app/timeline.h: the modeler's history played as a film, scrubbed, played and sent back.
 #include <gtest/gtest.h>
 
-#include "app/document.h"
 #include "app/timeline.h"
+#include "document/document.h"
 #include "document_strokes.h"
 #include "grids.h"
 #include "io/start_grid.h"
