@@ -10,11 +10,9 @@
 #include "vdb/parallel.h"
 
 #include <algorithm>
-#include <array>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
-#include <limits>
 #include <map>
 #include <utility>
 #include <vector>

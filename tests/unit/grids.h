@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -11,6 +10,7 @@
 
 #include <openvdb/tools/SignedFloodFill.h>
 
+#include "io/film_files.h"
 #include "levelset/create.h"
 
 namespace sweepers::test {
@@ -98,28 +98,19 @@ inline std::size_t changedOutside(const Grid& a, const Grid& b,
 }
 
 // A digest of every value of the grid (voxels and tiles, to the bit), its state, and where it
-// lies: 16 hex digits (64-bit FNV-1a over the tree's walk). Two grids with the same digest
-// hold the same values; a grid written before a change of the code and one written after it
-// are compared by their digests alone.
+// lies: the films' 16 hex digits (64-bit FNV-1a, io/film_files.h) over the tree's walk. Two
+// grids with the same digest hold the same values; a grid written before a change of the code
+// and one written after it are compared by their digests alone.
 inline std::string gridDigest(const Grid& g) {
-    std::uint64_t d = 0xcbf29ce484222325ull;
-    const auto mix = [&](const void* data, std::size_t n) {
-        const auto* bytes = static_cast<const unsigned char*>(data);
-        for (std::size_t i = 0; i < n; ++i) {
-            d ^= bytes[i];
-            d *= 0x100000001b3ull;
-        }
-    };
+    std::string bytes;
     for (auto it = g.cbeginValueAll(); it; ++it) {
         const openvdb::Coord c = it.getCoord();
         const float v = *it;
         const std::int32_t at[5] = {c.x(), c.y(), c.z(), int(it.getDepth()), int(it.isValueOn())};
-        mix(at, sizeof at);
-        mix(&v, sizeof v);
+        bytes.append(reinterpret_cast<const char*>(at), sizeof at);
+        bytes.append(reinterpret_cast<const char*>(&v), sizeof v);
     }
-    char hex[17];
-    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(d));
-    return hex;
+    return scriptDigest(bytes);
 }
 
 } // namespace sweepers::test

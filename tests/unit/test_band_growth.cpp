@@ -9,20 +9,14 @@
 #include <gtest/gtest.h>
 #include <openvdb/tools/Morphology.h>
 
-#include "grids.h"
 #include "levelset/band_growth.h"
+#include "levelset/create.h"
 #include "levelset/dilate.h"
+#include "vdb/local_tree.h"
 
 using namespace sweepers;
 
 namespace {
-
-std::vector<LeafNode*> leavesOf(Grid& g) {
-    std::vector<LeafNode*> leaves;
-    for (auto leaf = g.tree().beginLeaf(); leaf; ++leaf)
-        leaves.push_back(leaf.getLeaf());
-    return leaves;
-}
 
 std::set<openvdb::Coord> leafOrigins(const Grid& g) {
     std::set<openvdb::Coord> origins;
@@ -62,12 +56,11 @@ TEST(BandGrowth, TheLeavesMadeAreThoseTheCubeDilationReaches) {
 // switched off (or one of its face neighbours), it did not, and the voxels missing are listed:
 // that voxel, and its inactive face neighbours within the box.
 TEST(BandGrowth, AVoxelNextToTheCrossingLeftOffIsFoundMissing) {
-    const GridPtr g =
-        test::gridFromSdf([](const Eigen::Vector3d& p) { return p.norm() - 0.4; }, 1.0 / 32, 3,
-                          openvdb::CoordBBox::createCube({-20, -20, -20}, 40));
+    const GridPtr g = makeSphere(Eigen::Vector3d::Zero(), 0.4, 1.0 / 32, 3.0);
     const openvdb::CoordBBox box = g->evalActiveVoxelBoundingBox();
-    EXPECT_TRUE(seedsSampled(*g, leavesOf(*g), box));
-    EXPECT_TRUE(unsampledSeeds(*g, leavesOf(*g), box).empty());
+    const auto leaves = [&] { return leavesIn(g->tree(), box); };
+    EXPECT_TRUE(seedsSampled(*g, leaves(), box));
+    EXPECT_TRUE(unsampledSeeds(*g, leaves(), box).empty());
 
     // The voxel on the +x axis just inside the surface (0.4 = 12.8 voxels: index 12 at 12.5).
     const openvdb::Coord seed(12, 0, 0);
@@ -75,8 +68,8 @@ TEST(BandGrowth, AVoxelNextToTheCrossingLeftOffIsFoundMissing) {
     ASSERT_LT(acc.getValue(seed), 0.0f);
     ASSERT_GT(acc.getValue(seed.offsetBy(1, 0, 0)), 0.0f);
     acc.setValueOff(seed);
-    EXPECT_FALSE(seedsSampled(*g, leavesOf(*g), box));
-    const VoxelList missing = unsampledSeeds(*g, leavesOf(*g), box);
+    EXPECT_FALSE(seedsSampled(*g, leaves(), box));
+    const VoxelList missing = unsampledSeeds(*g, leaves(), box);
     std::set<openvdb::Coord> listed;
     for (const LeafVoxels& leaf : missing)
         for (int pos = 0; pos < 512; ++pos)
@@ -86,5 +79,5 @@ TEST(BandGrowth, AVoxelNextToTheCrossingLeftOffIsFoundMissing) {
 
     // Outside the box, the same voxel is not looked at.
     const openvdb::CoordBBox without({-20, -20, -20}, {11, 20, 20});
-    EXPECT_TRUE(unsampledSeeds(*g, leavesOf(*g), without).empty());
+    EXPECT_TRUE(unsampledSeeds(*g, leaves(), without).empty());
 }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "grids.h"
+#include "levelset/create.h"
 #include "levelset/leaf_snapshot.h"
 
 using namespace sweepers;
@@ -12,8 +13,7 @@ using sweepers::test::differingBits;
 namespace {
 
 GridPtr ball() {
-    return test::gridFromSdf([](const Eigen::Vector3d& p) { return p.norm() - 0.5; }, 1.0 / 32, 3,
-                             openvdb::CoordBBox::createCube({-24, -24, -24}, 48));
+    return makeSphere(Eigen::Vector3d::Zero(), 0.5, 1.0 / 32, 3.0);
 }
 
 // Changes everything of kind a stroke changes inside `box`: values and states of band voxels,

@@ -7,7 +7,9 @@
 #include <gtest/gtest.h>
 
 #include "grids.h"
+#include "levelset/create.h"
 #include "levelset/resample.h"
+#include "vdb/local_tree.h"
 
 using namespace sweepers;
 using sweepers::test::differingBits;
@@ -16,16 +18,13 @@ namespace {
 
 constexpr double kH = 1.0 / 32; // a power of two: voxel centres and one-voxel moves are exact
 
+// Every leaf of the band.
 std::vector<LeafNode*> leavesOf(Grid& g) {
-    std::vector<LeafNode*> leaves;
-    for (auto leaf = g.tree().beginLeaf(); leaf; ++leaf)
-        leaves.push_back(leaf.getLeaf());
-    return leaves;
+    return leavesIn(g.tree(), g.evalActiveVoxelBoundingBox());
 }
 
 GridPtr ball() {
-    return test::gridFromSdf([](const Eigen::Vector3d& p) { return p.norm() - 0.4; }, kH, 3,
-                             openvdb::CoordBBox::createCube({-20, -20, -20}, 40));
+    return makeSphere(Eigen::Vector3d::Zero(), 0.4, kH, 3.0);
 }
 
 LeafMap shiftedBy(const Eigen::Vector3d& d) {
