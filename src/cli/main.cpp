@@ -20,6 +20,7 @@
 #include <tbb/global_control.h>
 #include <unistd.h>
 
+#include "cli/check_command.h"
 #include "cli/command.h"
 #include "cli/progress.h"
 #include "cli/study_command.h"
@@ -116,127 +117,6 @@ void requireWritable(const std::string& path) {
     if (::access(dir.c_str(), W_OK) != 0)
         throw std::runtime_error(path + ": cannot write there (" + dir +
                                  " is not a writable directory)");
-}
-
-int runCheck(const std::string& path) {
-    const StrokeScript script = readStrokeScript(path);
-    requireBuildableStart(script); // the limits apply holds the script to
-    json out = json::array();
-    // One row per deformation: its stroke, kind, tools, sub-steps and reach.
-    const auto row = [&](std::size_t stroke, const std::string& type, std::size_t segment,
-                         std::size_t tools, const StepDeformation& seg, double bound) {
-        out.push_back({{"stroke", stroke},
-                       {"type", type},
-                       {"segment", segment},
-                       {"tools", tools},
-                       {"steps", seg.steps()},
-                       {"bound", bound},
-                       {"affected_box", {vec(seg.affectedBox().min), vec(seg.affectedBox().max)}}});
-    };
-    for (std::size_t i = 0; i < script.strokes.size(); ++i) {
-        const Stroke& stroke = script.strokes[i];
-        if (const auto* sweep = std::get_if<SweepStroke>(&stroke)) {
-            const Sweep sw = toSweep(*sweep);
-            for (std::size_t k = 0; k < sw.segmentCount(); ++k) {
-                const SweepSegment seg(sw, k);
-                row(i, "sweep", k, seg.toolCount(), seg, seg.stepBound());
-            }
-        } else if (const auto* swirl = std::get_if<SwirlStroke>(&stroke)) {
-            row(i, swirl->ball > 0 ? "star-shaped swirl" : "swirl", 0, 1,
-                SwirlSegment(toSwirl(*swirl)), 0.0);
-        } else if (std::holds_alternative<InflateStroke>(stroke)) {
-            out.push_back({{"stroke", i}, {"type", "inflate"}});
-        } else if (std::holds_alternative<SmoothStroke>(stroke)) {
-            // Not a deformation: each dab relaxes the surface under the ball.
-            out.push_back({{"stroke", i},
-                           {"type", "smooth"},
-                           {"dabs", segmentCount(stroke, script.grid.voxelSize)}});
-        } else if (const auto* flow = std::get_if<FlowStroke>(&stroke)) {
-            // Without a segment count, the segments are chosen on the shape when applied.
-            const auto field = makeField(flow->field);
-            const auto parts = planFlow(field, flow->from, flow->to, std::max(1, flow->segments));
-            for (std::size_t k = 0; k < parts.size(); ++k)
-                row(i, "flow (" + fieldName(flow->field.kind) + ")", k, 0, *parts[k], 0.0);
-            if (flow->segments == 0) out.back()["segments"] = "chosen on the shape";
-        } else if (const auto* fluid = std::get_if<FluidStroke>(&stroke)) {
-            // Each segment chains the flow steps of 4.26 (their count in "fluid_steps").
-            for (std::size_t k = 0; k + 1 < fluid->path.size(); ++k) {
-                row(i, "fluid", k, 1,
-                    *sweptFluidSegment(*fluid->fluid, fluid->radius, fluid->path[k],
-                                       fluid->path[k + 1]),
-                    0.0);
-                out.back()["fluid_steps"] = sweptFluidSteps(*fluid->fluid, fluid->radius,
-                                                            fluid->path[k], fluid->path[k + 1]);
-            }
-        } else if (keyedDuration(stroke) > 0.0) {
-            // As `apply` takes it: at its last key.
-            const bool keyframed = std::holds_alternative<KeyframedStroke>(stroke);
-            const auto parts = planKeyedStroke(stroke, keyedDuration(stroke));
-            if (parts.empty()) out.push_back({{"stroke", i}, {"type", "keyframed at rest"}});
-            for (std::size_t k = 0; k < parts.size(); ++k) {
-                const auto& seg = dynamic_cast<const SweepSegment&>(*parts[k]);
-                row(i, keyframed ? "keyframed" : "slide", k, seg.toolCount(), seg, seg.stepBound());
-            }
-        } else {
-            // A pinch or a strangle: its sub-steps depend on the voxel size (the script's).
-            const auto* pinch = std::get_if<PinchStroke>(&stroke);
-            const double h = script.grid.voxelSize;
-            const auto parts =
-                pinch ? planPinch(*pinch, h) : planStrangle(std::get<StrangleStroke>(stroke), h);
-            for (std::size_t k = 0; k < parts.size(); ++k) {
-                const bool pull = parts[k]->tears();
-                row(i,
-                    std::string(pinch ? "pinch" : "strangle") + (pull    ? " pull"
-                                                                 : pinch ? " needles"
-                                                                         : " noose"),
-                    k, pinch && !pull ? 2 : 1, *parts[k], 0.0);
-            }
-        }
-    }
-    if (gOut.json) {
-        printJson({{"script", path},
-                   {"valid", true},
-                   {"strokes", script.strokes.size()},
-                   {"voxel_size", script.grid.voxelSize},
-                   {"half_width", script.grid.halfWidth},
-                   {"deformations", out}});
-        return kDone;
-    }
-    std::cout << path << ": valid, " << script.strokes.size() << " strokes\n";
-    for (const auto& row : out) {
-        if (row["type"] == "inflate") {
-            std::cout << "  stroke " << row["stroke"] << ": inflate (reaches the whole shape)\n";
-            continue;
-        }
-        if (row["type"] == "smooth") {
-            std::cout << "  stroke " << row["stroke"] << ": smooth, " << row["dabs"]
-                      << " dab(s) of curvature flow under the brush\n";
-            continue;
-        }
-        if (row["type"] == "keyframed at rest") {
-            std::cout << "  stroke " << row["stroke"]
-                      << ": keyframed, back at rest at its last key (apply leaves the shape)\n";
-            continue;
-        }
-        if (row.contains("segments")) {
-            std::cout << "  stroke " << row["stroke"] << ": " << row["type"].get<std::string>()
-                      << ", " << row["steps"] << " sub-steps, in as many segments as the "
-                      << "shape's stretch needs (chosen when applied), affected box "
-                      << row["affected_box"].dump() << "\n";
-            continue;
-        }
-        if (row["type"] != "sweep") {
-            std::cout << "  stroke " << row["stroke"] << ": " << row["type"].get<std::string>()
-                      << ", " << row["steps"] << " sub-steps, affected box "
-                      << row["affected_box"].dump() << "\n";
-            continue;
-        }
-        std::cout << "  stroke " << row["stroke"] << " segment " << row["segment"] << ": "
-                  << row["tools"] << " tool(s), " << row["steps"] << " sub-steps (bound "
-                  << row["bound"].get<double>() << "), affected box " << row["affected_box"].dump()
-                  << "\n";
-    }
-    return 0;
 }
 
 json infoJson(const LevelSetMeasures& m) {
@@ -495,6 +375,16 @@ int runApply(const ApplyArgs& a) {
         j["output"] = a.output;
         j["mesh"] = meshFile ? meshJson(a.mesh, mesh) : json(nullptr);
         j["segments"] = reports.size();
+        if (a.stats) {
+            // The steps run, in the rows check prints for its plan (the same function), each
+            // with what running it took.
+            json steps = json::array();
+            for (const SegmentReport& r : reports) {
+                steps.push_back(stepJson(r.stroke, r.step));
+                steps.back()["ran"] = {{"sub_steps", r.stats.subSteps}, {"seconds", r.seconds}};
+            }
+            j["deformations"] = steps;
+        }
         j["volume_before"] = before;
         j["volume_change_pct"] = 100.0 * (after - before) / before;
         j["timings"] = {{"wall_s", wall},
@@ -714,8 +604,13 @@ static int run(int argc, char** argv) {
     limitOptions(&app);
 
     std::string path, output;
+    CheckArgs checkArgs;
     CLI::App* check = app.add_subcommand("check", "Validate a stroke script and show its plan");
-    check->add_option("script", path, "Stroke script (JSON)")->required();
+    check->add_option("script", checkArgs.script, "Stroke script (JSON)")->required();
+    check
+        ->add_option("--voxel-size", checkArgs.voxelSize,
+                     "Plan at this voxel size, as apply --voxel-size runs (default: the script's)")
+        ->check(positiveNumber());
     jsonFlag(check, "the plan");
 
     double radius = 1.0, voxelSize = 0.02, halfWidth = 3.0;
@@ -854,7 +749,7 @@ static int run(int argc, char** argv) {
         limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                       std::size_t(threads));
     try {
-        if (*check) return runCheck(path);
+        if (*check) return runCheck(checkArgs);
         if (*info) return runInfo(path, gridName);
         if (*apply) return runApply(applyArgs);
         if (*recover) return runRecover(path, output, scriptOut);

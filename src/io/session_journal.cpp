@@ -47,7 +47,7 @@ json strokesJson(const std::vector<Stroke>& strokes) {
 
 std::vector<Stroke> readStrokes(const json& strokes, const std::string& name,
                                 const std::string& scriptDir) {
-    return parseStrokeScript(json{{"sweepers", 1}, {"strokes", strokes}}.dump(), name, scriptDir)
+    return loadStrokeScript(json{{"sweepers", 1}, {"strokes", strokes}}.dump(), name, scriptDir)
         .strokes;
 }
 
@@ -131,7 +131,7 @@ JournalState readJournal(const std::string& dir) {
                 if (!j.is_object() || j.value("session", 0) != 1 || !j.contains("script"))
                     throw std::runtime_error("not a session journal");
                 st.scriptDir = j.at("dir").get<std::string>();
-                st.script = parseStrokeScript(j.at("script").dump(), where, st.scriptDir);
+                st.script = loadStrokeScript(j.at("script").dump(), where, st.scriptDir);
             } else if (j.contains("append")) {
                 const std::vector<Stroke> strokes =
                     readStrokes(j.at("append"), where, st.scriptDir);

@@ -69,11 +69,7 @@ const std::vector<const char*>& fieldsOf(std::string_view object) {
 
 class Reader {
   public:
-    explicit Reader(const std::string& name, const std::string& baseDir = "")
-        : name_(name), baseDir_(baseDir) {}
-
-    // Where the script's relative file names are taken from.
-    const std::string& baseDir() const { return baseDir_; }
+    explicit Reader(const std::string& name) : name_(name) {}
     // The script's voxel size, once /grid is read (a mesh tool's default sampling).
     double voxelSize = GridSpec().voxelSize;
 
@@ -138,7 +134,6 @@ class Reader {
 
   private:
     const std::string& name_;
-    const std::string& baseDir_;
 };
 
 Placement readPlacement(const Reader& r, const json& v, const std::string& at) {
@@ -190,25 +185,19 @@ BakedToolSource readBakedSource(const Reader& r, const json& v, const std::strin
     return b;
 }
 
-// Reads the baked tool's file: after its path, whose scales bound the band it needs.
-void loadTool(const Reader& r, ToolSpec& t, const std::string& at) {
-    double smallest = t.size.x(), largest = t.size.x();
+// A baked tool's path, checked when read: the tool can only be scaled uniformly, and a mesh
+// is sampled at least as finely as the sculpt, wherever the tool is largest.
+void checkBakedPath(const Reader& r, ToolSpec& t, const std::string& at) {
+    double largest = t.size.x();
     for (std::size_t i = 0; i < t.path.size(); ++i) {
         const Placement& p = t.path[i];
         if (!p.uniformScale())
             r.fail(at + "/path/" + std::to_string(i) + "/s",
                    "a baked tool can only be scaled uniformly");
-        smallest = std::min(smallest, t.size.x() * p.scale.x());
         largest = std::max(largest, t.size.x() * p.scale.x());
     }
-    // A mesh is sampled at least as finely as the sculpt, wherever the tool is largest.
     if (t.source.kind == BakedToolSource::Kind::Mesh && t.source.voxelSize == 0.0)
         t.source.voxelSize = r.voxelSize / largest;
-    try {
-        t.baked = loadBakedTool(t.source, r.baseDir(), t.size.x(), t.falloff / smallest);
-    } catch (const std::exception& e) {
-        r.fail(at + "/shape", e.what());
-    }
 }
 
 // A tool with its path, or (`keyed`) with the placements keyed elsewhere as its path.
@@ -252,7 +241,7 @@ ToolSpec readTool(const Reader& r, const json& v, const std::string& at,
         for (std::size_t i = 0; i < path.size(); ++i)
             t.path.push_back(readPlacement(r, path[i], at + "/path/" + std::to_string(i)));
     }
-    if (t.shape == ToolShapeKind::Baked) loadTool(r, t, at);
+    if (t.shape == ToolShapeKind::Baked) checkBakedPath(r, t, at);
     return t;
 }
 
@@ -285,6 +274,41 @@ RadialSymmetry readRadial(const Reader& r, const json& v, const std::string& at)
     return radial;
 }
 
+bool hasBakedTool(const SweepStroke& s) {
+    return std::any_of(s.tools.begin(), s.tools.end(),
+                       [](const ToolSpec& t) { return t.shape == ToolShapeKind::Baked; });
+}
+
+// Every segment's motion must have a logarithm and a sane number of sub-steps; the count
+// depends on the tools' shapes, so a sweep with a baked tool is checked once its file is
+// read (loadScriptInputs).
+void checkSweepSegments(const Reader& r, const SweepStroke& s, const std::string& at) {
+    const Sweep sweep = toSweep(s);
+    for (std::size_t k = 0; k < sweep.segmentCount(); ++k) {
+        try {
+            SweepSegment segment(sweep, k);
+        } catch (const std::exception& e) {
+            r.fail(at + "/tools/0/path/" + std::to_string(k + 1),
+                   std::string("segment ") + std::to_string(k) + ": " + e.what());
+        }
+    }
+}
+
+// Every keyed placement must be reachable from the rest by one motion with a logarithm
+// (checked as a sweep's segments are, and when they are).
+void checkKeyedMotions(const Reader& r, const KeyframedStroke& s, const std::string& at) {
+    for (std::size_t i = 1; i < s.keys.placements.size(); ++i) {
+        SweepStroke grab;
+        grab.tools = {s.tool};
+        grab.tools[0].path = {s.keys.placements[0], s.keys.placements[i]};
+        try {
+            SweepSegment segment(toSweep(grab), 0);
+        } catch (const std::exception& e) {
+            r.fail(at + "/keys/" + std::to_string(i), std::string("from the rest: ") + e.what());
+        }
+    }
+}
+
 SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "sweep");
     SweepStroke s;
@@ -311,16 +335,7 @@ SweepStroke readSweep(const Reader& r, const json& v, const std::string& at) {
             r.fail(at + "/tools/" + std::to_string(i) + "/path",
                    "tools swept together need the same number of placements");
 
-    // Every segment's motion must have a logarithm and a sane number of sub-steps.
-    const Sweep sweep = toSweep(s);
-    for (std::size_t k = 0; k < sweep.segmentCount(); ++k) {
-        try {
-            SweepSegment segment(sweep, k);
-        } catch (const std::exception& e) {
-            r.fail(at + "/tools/0/path/" + std::to_string(k + 1),
-                   std::string("segment ") + std::to_string(k) + ": " + e.what());
-        }
-    }
+    if (!hasBakedTool(s)) checkSweepSegments(r, s, at);
     return s;
 }
 
@@ -354,17 +369,7 @@ KeyframedStroke readKeyframed(const Reader& r, const json& v, const std::string&
     KeyframedStroke s;
     s.keys = readKeys(r, v, at, false);
     s.tool = readTool(r, r.require(v, at, "tool"), at + "/tool", &s.keys.placements);
-    // Every keyed placement must be reachable from the rest by one motion with a logarithm.
-    for (std::size_t i = 1; i < s.keys.placements.size(); ++i) {
-        SweepStroke grab;
-        grab.tools = {s.tool};
-        grab.tools[0].path = {s.keys.placements[0], s.keys.placements[i]};
-        try {
-            SweepSegment segment(toSweep(grab), 0);
-        } catch (const std::exception& e) {
-            r.fail(at + "/keys/" + std::to_string(i), std::string("from the rest: ") + e.what());
-        }
-    }
+    if (s.tool.shape != ToolShapeKind::Baked) checkKeyedMotions(r, s, at);
     return s;
 }
 
@@ -391,11 +396,6 @@ FluidStroke readFluid(const Reader& r, const json& v, const std::string& at) {
         if (i > 0 && s.path[i] == s.path[i - 1])
             r.fail(at + "/path/" + std::to_string(i),
                    "the tool does not move from the point before");
-    }
-    try {
-        s.fluid = sweptFluid();
-    } catch (const std::exception& e) {
-        r.fail(at, std::string("cannot solve the swept fluid: ") + e.what());
     }
     return s;
 }
@@ -457,6 +457,15 @@ SmoothStroke readSmooth(const Reader& r, const json& v, const std::string& at) {
     return s;
 }
 
+// Sub-steps last at most 1 / (2 L) (deform/flow.h): a span that needs more than a hundred
+// thousand of them is refused before any work.
+void checkFlowSpan(const Reader& r, const FlowStroke& s, const std::string& at) {
+    const double subSteps = 2.0 * makeField(s.field)->lipschitz() * (s.to - s.from);
+    if (subSteps > 1e5)
+        r.fail(at, "the flow would take " + formatNumber(std::ceil(subSteps)) +
+                       " sub-steps (more than 100000): shorten its time or slow its field");
+}
+
 FlowStroke readFlow(const Reader& r, const json& v, const std::string& at) {
     r.onlyKeys(v, at, "flow");
     FlowStroke s;
@@ -484,12 +493,6 @@ FlowStroke readFlow(const Reader& r, const json& v, const std::string& at) {
         s.field.kind = FieldSpec::Kind::Sampled;
         s.field.file = r.string(f["vdb"], fat + "/vdb");
         if (f.contains("grid")) s.field.gridName = r.string(f["grid"], fat + "/grid");
-        try {
-            s.field.sampled = std::make_shared<SampledField>(
-                readVelocitySamples(resolveAgainst(s.field.file, r.baseDir()), s.field.gridName));
-        } catch (const std::exception& e) {
-            r.fail(fat + "/vdb", e.what());
-        }
     } else {
         r.fail(fat, "expected \"enright\", \"vortex\", {\"rotation\": {...}} or {\"vdb\": file}, "
                     "got " +
@@ -506,12 +509,8 @@ FlowStroke readFlow(const Reader& r, const json& v, const std::string& at) {
                    "expected a whole number from 1 to 4096, got " + Reader::describe(*it));
         s.segments = it->get<int>();
     }
-    // Sub-steps last at most 1 / (2 L) (deform/flow.h): a span that needs more than a
-    // hundred thousand of them is refused before any work.
-    const double subSteps = 2.0 * makeField(s.field)->lipschitz() * (s.to - s.from);
-    if (subSteps > 1e5)
-        r.fail(at, "the flow would take " + formatNumber(std::ceil(subSteps)) +
-                       " sub-steps (more than 100000): shorten its time or slow its field");
+    // A sampled field's speed is known once its file is read (loadScriptInputs).
+    if (s.field.kind != FieldSpec::Kind::Sampled) checkFlowSpan(r, s, at);
     return s;
 }
 
@@ -675,9 +674,8 @@ struct DuplicateKeys {
 
 } // namespace
 
-StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
-                               const std::string& baseDir) {
-    Reader r(name, baseDir);
+StrokeScript parseStrokeScript(const std::string& text, const std::string& name) {
+    Reader r(name);
     json root;
     DuplicateKeys duplicates;
     try {
@@ -772,7 +770,67 @@ StrokeScript readStrokeScript(const std::string& path, std::string* text) {
         throw ScriptError(e.what());
     }
     if (text) *text = all;
-    return parseStrokeScript(all, path, directoryOf(path));
+    return loadStrokeScript(all, path, directoryOf(path));
+}
+
+void loadScriptInputs(StrokeScript& script, const std::string& name, const std::string& baseDir) {
+    const Reader r(name);
+    // A baked tool's file: the band it needs reaches its falloff at the smallest scale it is
+    // placed with.
+    const auto load = [&](ToolSpec& t, const std::string& at) {
+        if (t.shape != ToolShapeKind::Baked || t.baked) return;
+        double smallest = t.size.x();
+        for (const Placement& p : t.path)
+            smallest = std::min(smallest, t.size.x() * p.scale.x());
+        try {
+            t.baked = loadBakedTool(t.source, baseDir, t.size.x(), t.falloff / smallest);
+        } catch (const std::exception& e) {
+            r.fail(at + "/shape", e.what());
+        }
+    };
+    const auto loadTools = [&](SweepStroke& s, const std::string& at) {
+        for (std::size_t j = 0; j < s.tools.size(); ++j)
+            load(s.tools[j], at + "/tools/" + std::to_string(j));
+        if (hasBakedTool(s)) checkSweepSegments(r, s, at);
+    };
+    for (std::size_t i = 0; i < script.strokes.size(); ++i) {
+        const std::string at = "/strokes/" + std::to_string(i);
+        Stroke& stroke = script.strokes[i];
+        if (auto* sweep = std::get_if<SweepStroke>(&stroke)) {
+            loadTools(*sweep, at);
+        } else if (auto* slide = std::get_if<SlideStroke>(&stroke)) {
+            loadTools(slide->local, at);
+        } else if (auto* keyed = std::get_if<KeyframedStroke>(&stroke)) {
+            load(keyed->tool, at + "/tool");
+            if (keyed->tool.shape == ToolShapeKind::Baked) checkKeyedMotions(r, *keyed, at);
+        } else if (auto* smooth = std::get_if<SmoothStroke>(&stroke)) {
+            load(smooth->tool, at + "/tool");
+        } else if (auto* flow = std::get_if<FlowStroke>(&stroke)) {
+            FieldSpec& field = flow->field;
+            if (field.kind != FieldSpec::Kind::Sampled || field.sampled) continue;
+            try {
+                field.sampled = std::make_shared<SampledField>(
+                    readVelocitySamples(resolveAgainst(field.file, baseDir), field.gridName));
+            } catch (const std::exception& e) {
+                r.fail(at + "/field/vdb", e.what());
+            }
+            checkFlowSpan(r, *flow, at);
+        } else if (auto* fluid = std::get_if<FluidStroke>(&stroke)) {
+            if (fluid->fluid) continue;
+            try {
+                fluid->fluid = sweptFluid();
+            } catch (const std::exception& e) {
+                r.fail(at, std::string("cannot solve the swept fluid: ") + e.what());
+            }
+        }
+    }
+}
+
+StrokeScript loadStrokeScript(const std::string& text, const std::string& name,
+                              const std::string& baseDir) {
+    StrokeScript script = parseStrokeScript(text, name);
+    loadScriptInputs(script, name, baseDir);
+    return script;
 }
 
 namespace {

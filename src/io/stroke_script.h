@@ -36,14 +36,24 @@ class ScriptError : public std::runtime_error {
     using std::runtime_error::runtime_error;
 };
 
-// Parse and validate; `name` is used in messages (usually the file path). Baked tools' and
-// velocity fields' files are read (relative names from `baseDir`, "" for the current
-// directory), the swept fluid found (io/fluid_cache.h), and a tool or field that cannot be
-// made refuses the script like any other mistake.
-StrokeScript parseStrokeScript(const std::string& text, const std::string& name,
-                               const std::string& baseDir = "");
-// Read a file (its baked tools relative to it); a missing or unreadable file is a
-// ScriptError too. `text`, if given, receives the file's text as it was parsed.
+// Parse and validate, touching no disk: a script is data. `name` is used in messages
+// (usually the file path). The files it names (a VDB or mesh start, baked tools, sampled
+// velocity fields) are kept as written, and what they hold, like the swept fluid's
+// solution, is left for loadScriptInputs; so are the checks that need it (a baked tool's
+// sub-steps, a sampled field's speed).
+StrokeScript parseStrokeScript(const std::string& text, const std::string& name);
+// Resolves what a parsed script reads (but its start, which io/start_grid.h builds): baked
+// tools' and velocity fields' files (relative names from `baseDir`, "" for the current
+// directory) and the swept fluid (io/fluid_cache.h). A tool or field that cannot be made
+// refuses the script as a parsing mistake does, at its JSON location. What is already loaded
+// is kept.
+void loadScriptInputs(StrokeScript& script, const std::string& name,
+                      const std::string& baseDir = "");
+// Both: a script ready to apply.
+StrokeScript loadStrokeScript(const std::string& text, const std::string& name,
+                              const std::string& baseDir = "");
+// Read a file, parse it and load its inputs (relative to it); a missing or unreadable file
+// is a ScriptError too. `text`, if given, receives the file's text as it was parsed.
 StrokeScript readStrokeScript(const std::string& path, std::string* text = nullptr);
 
 // Every field name a script may hold, in any object: the parser refuses all others, and the

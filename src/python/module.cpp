@@ -222,16 +222,15 @@ struct GivenScript {
 GivenScript scriptFrom(const py::handle& value) {
     const std::string here = std::filesystem::current_path().string();
     if (py::isinstance<py::dict>(value))
-        return {
-            parseStrokeScript(textOf(value, "the script (a dict)"), "the script (a dict)", here),
-            here};
+        return {loadStrokeScript(textOf(value, "the script (a dict)"), "the script (a dict)", here),
+                here};
     if (!py::isinstance<py::str>(value) && !isPath(value))
         throw py::type_error("script: a path, a JSON string or a dict, not " +
                              py::str(py::type::of(value)).cast<std::string>());
     const std::string text = pathOf(value);
     const std::size_t first = text.find_first_not_of(" \t\r\n");
     if (py::isinstance<py::str>(value) && first != std::string::npos && text[first] == '{')
-        return {parseStrokeScript(text, "the script (a JSON string)", here), here};
+        return {loadStrokeScript(text, "the script (a JSON string)", here), here};
     try {
         return {readStrokeScript(text), directoryOf(text)};
     } catch (const ScriptError& e) {
@@ -418,8 +417,8 @@ std::vector<Stroke> strokesFrom(const py::object& strokes) {
     py::dict script;
     script["sweepers"] = 1;
     script["strokes"] = list;
-    return parseStrokeScript(textOf(script, "the strokes"), "the strokes",
-                             std::filesystem::current_path().string())
+    return loadStrokeScript(textOf(script, "the strokes"), "the strokes",
+                            std::filesystem::current_path().string())
         .strokes;
 }
 
@@ -611,7 +610,7 @@ PYBIND11_MODULE(sweepers, m) {
                  script["strokes"] = py::list();
                  const std::string here = std::filesystem::current_path().string();
                  const StrokeScript parsed =
-                     parseStrokeScript(textOf(script, "the start"), "the start", here);
+                     loadStrokeScript(textOf(script, "the start"), "the start", here);
                  return runEngine(py::none(), "start", [&](Interrupter* stop, const Progress&) {
                      return std::make_unique<Session>(parsed, here, stop);
                  });

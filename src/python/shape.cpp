@@ -121,7 +121,7 @@ void Session::apply(const std::vector<Stroke>& strokes, Interrupter* interrupter
         for (const Stroke& stroke : strokes) {
             applied.emplace_back();
             document_.applyStroke(stroke, [&](const SegmentReport& r) {
-                applied.back().push_back(r.deformation);
+                applied.back().push_back(r.step.deformation);
                 if (progress) progress(++done, total);
                 // A stop asked for by the report (Python's callback raised) takes the call back
                 // even after the last segment, when the engine polls no more.

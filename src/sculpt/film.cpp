@@ -7,6 +7,7 @@
 
 #include "core/checks.h"
 #include "deform/step_prefix.h"
+#include "sculpt/stroke_plan.h"
 
 namespace sweepers {
 
@@ -126,8 +127,8 @@ void FilmPlayer::seek(std::size_t n) {
                 putOn(on);
                 break;
             }
-            for (const auto& part : planStroke(sculptor_.grid(), stroke))
-                sculptor_.applySegment(*part);
+            for (const PlannedStep& step : planStroke(sculptor_.grid(), stroke))
+                sculptor_.applySegment(*step.deformation);
             start_ = end;
             ++i_;
             continue;
@@ -143,7 +144,9 @@ void FilmPlayer::seek(std::size_t n) {
             continue;
         }
         if (!planned_) {
-            parts_ = planStroke(sculptor_.grid(), stroke);
+            parts_.clear();
+            for (PlannedStep& step : planStroke(sculptor_.grid(), stroke))
+                parts_.push_back(std::move(step.deformation));
             k_ = 0;
             planned_ = true;
             if (parts_.empty()) { // a stroke that deforms nothing still lasts

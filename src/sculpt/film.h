@@ -65,7 +65,7 @@ class FilmPlayer {
     // for a keyed stroke), the next one k_, and the time the next one starts.
     std::size_t i_ = 0, k_ = 0;
     bool planned_ = false, partialOn_ = false;
-    std::vector<std::unique_ptr<StepDeformation>> parts_;
+    std::vector<std::shared_ptr<const StepDeformation>> parts_;
     double start_ = 0.0;
 };
 

@@ -77,21 +77,10 @@ SegmentReport Sculptor::applySmoothDab(const SmoothBrush& brush) {
 SegmentReport Sculptor::applyStroke(const Stroke& stroke,
                                     const std::function<void(const SegmentReport&)>& each) {
     SegmentReport last;
-    if (const auto* smooth = std::get_if<SmoothStroke>(&stroke)) {
-        const std::size_t dabs = smooth->tool.path.size() * std::size_t(smooth->radial.count);
-        for (std::size_t k = 0; k < dabs; ++k) {
-            last = applySmoothDab(smoothDab(*smooth, k));
-            last.segment = k;
-            if (each) each(last);
-        }
-        return last;
-    }
-    auto parts = planStroke(*grid_, stroke);
-    for (std::size_t k = 0; k < parts.size(); ++k) {
-        std::shared_ptr<const StepDeformation> part = std::move(parts[k]);
-        last = applySegment(*part);
-        last.segment = k;
-        last.deformation = std::move(part);
+    for (PlannedStep& step : planStroke(*grid_, stroke)) {
+        last = step.dab ? applySmoothDab(*step.dab) : applySegment(*step.deformation);
+        last.segment = step.segment;
+        last.step = std::move(step);
         if (each) each(last);
     }
     return last;
@@ -109,8 +98,8 @@ std::vector<SegmentReport> applyStrokes(Sculptor& sculptor, const std::vector<St
         sculptor.applyStroke(strokes[i], [&](const SegmentReport& r) {
             reports.push_back(r);
             reports.back().stroke = i;
-            if (history) history->push_back(r.deformation);
-            reports.back().deformation.reset();
+            if (history) history->push_back(r.step.deformation);
+            reports.back().step.deformation.reset();
             if (sculptor.meshing()) reports.back().meshVolume = sculptor.mesher().enclosedVolume();
             if (progress) progress(++done, total);
         });

@@ -16,14 +16,15 @@
 #include "levelset/leaf_snapshot.h"
 #include "mesh/marching_cubes.h"
 #include "sculpt/stroke.h"
+#include "sculpt/stroke_plan.h"
 
 namespace sweepers {
 
 struct SegmentReport {
     std::size_t stroke = 0, segment = 0;
-    // The deformation the segment applied, as planned (applyStroke): what an exact reference
-    // of the history composes.
-    std::shared_ptr<const StepDeformation> deformation;
+    // The step the segment applied, as planned (applyStroke; sculpt/stroke_plan.h): its
+    // deformation is what an exact reference of the history composes.
+    PlannedStep step;
     AdvectStats stats;
     double seconds = 0.0;     // advection, renormalization included
     double meshSeconds = 0.0; // incremental re-meshing of the touched leaves (when meshing)

@@ -4,50 +4,9 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <openvdb/tools/Interpolation.h>
-
-#include "core/format.h"
-#include "core/limits.h"
-#include "deform/inflate.h"
-#include "levelset/band.h"
 #include "tools/ellipsoid.h"
 
 namespace sweepers {
-
-namespace {
-
-// Peak resident memory per band voxel an inflation adds, while it is applied (the new band,
-// the sampled band's copies and the fill's marks), with headroom.
-constexpr double kInflationBytesPerVoxel = 400.0;
-
-// Where an inflation planned at `centre` is centred (inflate.h says why): a centre just
-// outside the surface, within the band, moves onto the surface along the normal (a few Newton
-// steps on the distance the grid holds); any other is kept.
-Eigen::Vector3d ontoSurface(const Grid& grid, const Eigen::Vector3d& centre) {
-    const double h = grid.voxelSize()[0], band = halfWidthOf(grid) * h;
-    const Grid::ConstAccessor acc = grid.getConstAccessor();
-    const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sample(
-        acc, grid.transform());
-    const auto at = [&](const Eigen::Vector3d& p) { return double(sample.wsSample(toVdb(p))); };
-    Eigen::Vector3d c = centre;
-    double d = at(c);
-    if (d >= 0.999 * band) return c;
-    for (int step = 0; step < 4 && d > 0.0; ++step) {
-        Eigen::Vector3d g;
-        for (int a = 0; a < 3; ++a) {
-            const Eigen::Vector3d e = h * Eigen::Vector3d::Unit(a);
-            g[a] = (at(c + e) - at(c - e)) / (2.0 * h);
-        }
-        if (!(g.norm() > 1e-6)) break;
-        c -= d / g.squaredNorm() * g;
-        d = at(c);
-    }
-    return c;
-}
-
-template <class... F> struct Overloaded : F... { using F::operator()...; };
-template <class... F> Overloaded(F...) -> Overloaded<F...>;
-} // namespace
 
 Eigen::Affine3d RadialSymmetry::turn(int k) const {
     return Eigen::Translation3d(center) *
@@ -136,8 +95,8 @@ double keyedDuration(const Stroke& stroke) {
     return 0.0;
 }
 
-std::vector<std::unique_ptr<StepDeformation>> planKeyedStroke(const Stroke& stroke, double time) {
-    std::vector<std::unique_ptr<StepDeformation>> parts;
+std::vector<std::unique_ptr<SweepSegment>> planKeyedStroke(const Stroke& stroke, double time) {
+    std::vector<std::unique_ptr<SweepSegment>> parts;
     if (const auto* k = std::get_if<KeyframedStroke>(&stroke)) {
         const Placement rest = k->keys.placements.front();
         const Placement target = keyedPlacement(k->keys, time);
@@ -195,84 +154,6 @@ std::size_t segmentCount(const Stroke& stroke, double voxelSize) {
     if (const auto* inflate = std::get_if<InflateStroke>(&stroke))
         return std::size_t(inflate->radial.count);
     return 1;
-}
-
-std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke) {
-    // Planned when the stroke comes: an inflation's reach is the shape as it is then.
-    std::vector<std::unique_ptr<StepDeformation>> parts;
-    // A swirl carrying a ball and an inflation reach the whole shape (found by walking the
-    // grid: only for those two).
-    auto reach = [&] { return activeWorldBox(grid).expanded(2 * grid.voxelSize()[0]); };
-    std::visit(
-        Overloaded{
-            [&](const SweepStroke& s) {
-                const Sweep sweep = toSweep(s);
-                for (std::size_t k = 0; k < sweep.segmentCount(); ++k)
-                    parts.push_back(std::make_unique<SweepSegment>(sweep, k));
-            },
-            [&](const SwirlStroke& s) {
-                for (int k = 0; k < s.radial.count; ++k) {
-                    if (s.ball > 0.0)
-                        parts.push_back(starShapedSwirl(toSwirl(s, k), s.ball, reach()));
-                    else
-                        parts.push_back(std::make_unique<SwirlSegment>(toSwirl(s, k)));
-                }
-            },
-            [&](const InflateStroke& s) {
-                // Planned on the shape as it is before the first copy: each copy may grow it
-                // by its ball, which the later copies' reach takes in.
-                const double rho = s.strength * s.radius;
-                const Box around = reach().expanded(2.0 * rho * (s.radial.count - 1));
-                const InflationFill fill{halfWidthOf(grid) * grid.voxelSize()[0]};
-                if (!s.remove) {
-                    // Each ball's surface joins the band: far larger a ball than the shape
-                    // makes the grid far larger than it was. (The grid there is already has
-                    // its memory.)
-                    const double h = grid.voxelSize()[0];
-                    const double voxels =
-                        s.radial.count * 4.0 * M_PI * rho * rho / (h * h) * 2.0 * halfWidthOf(grid);
-                    requireMemory(voxels * kInflationBytesPerVoxel,
-                                  "an inflation of radius " + formatNumber(rho),
-                                  formatNumber(voxels) + " band voxels at voxel size " +
-                                      formatNumber(h));
-                }
-                for (int k = 0; k < s.radial.count; ++k) {
-                    const Eigen::Vector3d at = s.radial.turn(k) * s.at;
-                    parts.push_back(std::make_unique<Inflation>(
-                        s.remove ? at : ontoSurface(grid, at), rho, around, s.remove, fill));
-                }
-            },
-            [&](const PinchStroke& s) { parts = planPinch(s, grid.voxelSize()[0]); },
-            [&](const StrangleStroke& s) { parts = planStrangle(s, grid.voxelSize()[0]); },
-            [&](const KeyframedStroke&) { parts = planKeyedStroke(stroke, keyedDuration(stroke)); },
-            [&](const SlideStroke&) { parts = planKeyedStroke(stroke, keyedDuration(stroke)); },
-            [&](const FlowStroke& s) {
-                const auto field = makeField(s.field);
-                const int n = s.segments > 0
-                                  ? s.segments
-                                  : flowSegments(*field, s.from, s.to, surfacePoints(grid, 512));
-                parts = planFlow(field, s.from, s.to, n);
-            },
-            [&](const FluidStroke& s) {
-                if (!s.fluid) throw std::invalid_argument("the swept fluid was not solved");
-                const std::vector<Eigen::Vector3d> path = s.ballPath();
-                // Each flow step resamples the band its segment reaches: at most the whole
-                // band, at most the voxels of the segment's box.
-                const double h = grid.voxelSize()[0], band = double(grid.activeVoxelCount());
-                for (std::size_t k = 0; k + 1 < path.size(); ++k) {
-                    parts.push_back(sweptFluidSegment(*s.fluid, s.radius, path[k], path[k + 1]));
-                    const Box box = parts.back()->affectedBox();
-                    const Eigen::Vector3d extent = (box.max - box.min) / h;
-                    requireWork(sweptFluidSteps(*s.fluid, s.radius, path[k], path[k + 1]) *
-                                    std::min(band, extent.prod()),
-                                "fluid segment " + std::to_string(k + 1) + " of radius " +
-                                    formatNumber(s.radius));
-                }
-            },
-            [&](const SmoothStroke&) {},
-        },
-        stroke);
-    return parts;
 }
 
 } // namespace sweepers

@@ -1,7 +1,7 @@
 // SPDX-License-Identifier: Apache-2.0
 // The stroke model: what a sculptor does to a shape, as data. A stroke script (io/) and
-// the modeler's drags (app/) both produce these; planStroke is the one place where a
-// stroke kind becomes deformations.
+// the modeler's drags (app/) both produce these; sculpt/stroke_plan.h is the one place where
+// a stroke kind becomes deformations.
 //
 //   sweep   - tools (balls, ellipsoids or baked shapes) moved along paths of placements
 //             (thesis 3.3, 3.4.3)
@@ -171,8 +171,8 @@ inline constexpr double kMostSmoothStrength = 10.0;
 // Smoothing under a ball: one dab at each placement of the tool's path (its translation; the
 // radius and falloff are the tool's), each a mean-curvature flow (levelset/smooth.h) lasting
 // strength x kSmoothTimePerRadius2 x radius^2. The velocity is the surface's own curvature,
-// so each dab runs on the grid the one before left: planStroke makes no deformation of it
-// (Sculptor::applyStroke runs the dabs), and a history holding one has no exact reference.
+// so each dab runs on the grid the one before left: its plan holds dabs, no deformation
+// (sculpt/stroke_plan.h), and a history holding one has no exact reference.
 struct SmoothStroke {
     ToolSpec tool;           // a ball
     double strength = 1.0;   // (0, kMostSmoothStrength]
@@ -208,19 +208,11 @@ double keyedDuration(const Stroke& stroke);
 
 // The deformations a keyed stroke makes at `time` of its own clock (empty where it is the
 // identity, as a keyframed tool at rest). Throws std::invalid_argument for another stroke.
-std::vector<std::unique_ptr<StepDeformation>> planKeyedStroke(const Stroke& stroke, double time);
+std::vector<std::unique_ptr<SweepSegment>> planKeyedStroke(const Stroke& stroke, double time);
 
-// How many deformations planStroke makes of a stroke at the given voxel size (a sweep's
-// segments, a pinch's or a strangle's segments and its pull, a flow's segments when it
-// gives them, a smooth stroke's dabs, else one).
+// How many steps planStroke (sculpt/stroke_plan.h) makes of a stroke at the given voxel size
+// (a sweep's segments, a pinch's or a strangle's segments and its pull, a flow's segments
+// when it gives them, a smooth stroke's dabs, else one), without planning it.
 std::size_t segmentCount(const Stroke& stroke, double voxelSize);
-
-// The deformations of one stroke, in order: a sweep's segments, one swirl ring or
-// inflation (whose reach depends on the grid as it is when the stroke comes), or the
-// segments of a pinch or a strangle (whose sub-steps depend on the voxel size), those of
-// a keyed stroke at its last key, a flow's or a fluid tool's segments; none for a smooth
-// stroke, which deforms nothing (Sculptor::applyStroke runs its dabs). Throws
-// std::invalid_argument for a fluid stroke whose solution was not found.
-std::vector<std::unique_ptr<StepDeformation>> planStroke(const Grid& grid, const Stroke& stroke);
 
 } // namespace sweepers

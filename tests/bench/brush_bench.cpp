@@ -84,7 +84,7 @@ std::vector<Stroke> strokesOf(const BrushCase& c) {
     const std::string text = std::string(R"({"sweepers": 1, "grid": {"voxel_size": 0.02},
         "start": {"sphere": {"center": [0, 0, 0], "radius": 1}}, "strokes": [)") +
                              c.stroke + "]}";
-    return parseStrokeScript(text, std::string("brushes/") + c.name + ".json", SWEEPERS_DATA_DIR)
+    return loadStrokeScript(text, std::string("brushes/") + c.name + ".json", SWEEPERS_DATA_DIR)
         .strokes;
 }
 

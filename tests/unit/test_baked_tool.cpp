@@ -79,7 +79,7 @@ double interfaceRms(const Grid& a, const Grid& b) {
 
 std::string scriptError(const std::string& text, const std::string& dir) {
     try {
-        parseStrokeScript(text, "tool.json", dir);
+        loadStrokeScript(text, "tool.json", dir);
     } catch (const ScriptError& e) {
         return e.what();
     }
@@ -162,8 +162,8 @@ TEST(BakedTool, SphereFromAVdbSculptsLikeTheBall) {
     writeLevelSet(*makeSphere(Eigen::Vector3d::Zero(), 1.0, 1.0 / 16, 3.0), dir / "sphere.vdb");
     for (const double size : {0.5, 0.25}) {
         const StrokeScript ball =
-            parseStrokeScript(sweepScript("\"ball\"", size, h), "ball.json", dir.path);
-        const StrokeScript baked = parseStrokeScript(
+            loadStrokeScript(sweepScript("\"ball\"", size, h), "ball.json", dir.path);
+        const StrokeScript baked = loadStrokeScript(
             sweepScript(R"({"vdb": "sphere.vdb"})", size, h), "baked.json", dir.path);
         const GridPtr a = sculpt(ball), b = sculpt(baked);
         const double rms = interfaceRms(*a, *b);
@@ -182,14 +182,14 @@ TEST(BakedTool, ClosedMeshSculptsLikeTheBall) {
     writeMesh(meshLevelSet(*makeSphere(Eigen::Vector3d::Zero(), 1.0, 1.0 / 16, 3.0)),
               dir / "sphere.ply");
     const StrokeScript ball =
-        parseStrokeScript(sweepScript("\"ball\"", 0.3, h), "ball.json", dir.path);
+        loadStrokeScript(sweepScript("\"ball\"", 0.3, h), "ball.json", dir.path);
     const StrokeScript baked =
-        parseStrokeScript(sweepScript(R"({"mesh": "sphere.ply"})", 0.3, h), "baked.json", dir.path);
+        loadStrokeScript(sweepScript(R"({"mesh": "sphere.ply"})", 0.3, h), "baked.json", dir.path);
     // The mesh is sampled as finely as the sculpt at the tool's size, unless told otherwise;
     // the sampling is written back, so the script replays with the same tool.
     const auto& tool = std::get<SweepStroke>(baked.strokes[0]).tools[0];
     EXPECT_NEAR(tool.source.voxelSize, h / 0.3, 1e-12);
-    const StrokeScript again = parseStrokeScript(formatStrokeScript(baked), "again", dir.path);
+    const StrokeScript again = loadStrokeScript(formatStrokeScript(baked), "again", dir.path);
     EXPECT_EQ(formatStrokeScript(again), formatStrokeScript(baked));
     const double rms = interfaceRms(*sculpt(ball), *sculpt(baked));
     std::printf("[ baked ] mesh sphere vs ball %.4f voxel RMS\n", rms);

@@ -151,7 +151,7 @@ TEST(SculptController, EveryReplayFileSculptsAndRecordsAScriptThatReplaysExactly
         ASSERT_FALSE(doc.script().strokes.empty()) << name;
         EXPECT_GT(differingVoxels(*before, doc.grid()), 100u) << name;
         const StrokeScript recorded =
-            parseStrokeScript(formatStrokeScript(doc.script()), "recorded " + name);
+            loadStrokeScript(formatStrokeScript(doc.script()), "recorded " + name);
         EXPECT_EQ(differingVoxels(*applyScript(recorded, "."), doc.grid()), 0u) << name;
         std::printf("[ replay ] %s: %zu strokes\n", name.c_str(), doc.script().strokes.size());
     }
@@ -392,7 +392,7 @@ TEST(SculptController, AToolFromAFileGrabsAndIsRecordedByItsFile) {
     s.ctl.useBall();
     drag();
     EXPECT_EQ(s.tool().shape, ToolShapeKind::Ball);
-    const StrokeScript recorded = parseStrokeScript(formatStrokeScript(s.doc.script()), "recorded");
+    const StrokeScript recorded = loadStrokeScript(formatStrokeScript(s.doc.script()), "recorded");
     EXPECT_EQ(differingVoxels(*applyScript(recorded, "."), s.doc.grid()), 0u);
 }
 
@@ -433,7 +433,7 @@ TEST(SculptController, FluidModePushesTheClayAsAFluidAndKeepsItsVolume) {
                 100.0 * (after - before) / before);
     EXPECT_LT(std::abs(after - before), 0.01 * before);
     EXPECT_GT(activeWorldBox(b.doc.grid()).max.x(), 1.1); // pulled out to the right
-    const StrokeScript recorded = parseStrokeScript(formatStrokeScript(b.doc.script()), "fluid");
+    const StrokeScript recorded = loadStrokeScript(formatStrokeScript(b.doc.script()), "fluid");
     EXPECT_EQ(differingVoxels(*applyScript(recorded, "."), b.doc.grid()), 0u);
 }
 

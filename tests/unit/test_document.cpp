@@ -94,7 +94,7 @@ TEST(Document, RecordedScriptReplaysToTheSameGrid) {
     doc.redo();
     doc.redo();
     EXPECT_EQ(doc.script().strokes.size(), 6u);
-    const StrokeScript replayed = parseStrokeScript(formatStrokeScript(doc.script()), "recorded");
+    const StrokeScript replayed = loadStrokeScript(formatStrokeScript(doc.script()), "recorded");
     const GridPtr g = applyScript(replayed, ".");
     EXPECT_EQ(differingVoxels(*g, doc.grid()), 0u);
 }

@@ -34,7 +34,7 @@ const char* kScript = R"({
 })";
 
 StrokeScript script() {
-    return parseStrokeScript(kScript, "film.json");
+    return loadStrokeScript(kScript, "film.json");
 }
 
 Sculptor startOf(const StrokeScript& s) {
@@ -138,7 +138,7 @@ TEST(Film, APlayerSeeksOnFromAnyFrame) {
 TEST(Film, APrefixIsTheFirstSubSteps) {
     const StrokeScript s = script();
     const auto parts = planStroke(startOf(s).grid(), s.strokes[0]);
-    const StepDeformation& whole = *parts[0];
+    const StepDeformation& whole = *parts[0].deformation;
     ASSERT_GE(whole.steps(), 2);
     const StepPrefix half(whole, whole.steps() / 2);
     EXPECT_EQ(half.steps(), whole.steps() / 2);
@@ -186,13 +186,13 @@ TEST(Film, PlacementsPartOfTheWay) {
 
 TEST(Film, DurationsRoundTripAndANegativeOneIsRefused) {
     const StrokeScript s = script();
-    const StrokeScript again = parseStrokeScript(formatStrokeScript(s), "again.json");
+    const StrokeScript again = loadStrokeScript(formatStrokeScript(s), "again.json");
     ASSERT_EQ(again.durations.size(), 1u);
     EXPECT_DOUBLE_EQ(again.durations[0], 0.5);
     std::string bad = kScript;
     bad.replace(bad.find("\"duration\": 0.5") + 12, 3, "-1");
     try {
-        parseStrokeScript(bad, "bad.json");
+        loadStrokeScript(bad, "bad.json");
         FAIL() << "a negative duration was taken";
     } catch (const ScriptError& e) {
         EXPECT_STREQ(e.what(), "bad.json: /strokes/0/duration: must be positive (got -1)");
@@ -279,7 +279,7 @@ TEST(Keyframes, ThroughEveryKeyAndHeldAtTheEnds) {
 }
 
 TEST(Film, AKeyframedGrabThatComesBackGivesBackTheStart) {
-    const StrokeScript s = parseStrokeScript(kGrab, "grab.json");
+    const StrokeScript s = loadStrokeScript(kGrab, "grab.json");
     FilmTiming timing;
     timing.fps = 10.0; // 11 frames
     const auto frames = play(s, timing);
@@ -302,7 +302,7 @@ TEST(Film, AKeyframedGrabThatComesBackGivesBackTheStart) {
 }
 
 TEST(Film, ASlidingBumpFollowsItsFrame) {
-    const StrokeScript s = parseStrokeScript(kSlide, "slide.json");
+    const StrokeScript s = loadStrokeScript(kSlide, "slide.json");
     FilmTiming timing;
     timing.fps = 4.0; // frames at 0, 0.25, 0.5, 0.75, 1 s
     const auto frames = play(s, timing);
@@ -321,14 +321,14 @@ TEST(Film, ASlidingBumpFollowsItsFrame) {
 
 TEST(Film, KeyedStrokesRoundTripAndBadKeysAreRefused) {
     for (const char* text : {kGrab, kSlide}) {
-        const StrokeScript s = parseStrokeScript(text, "keyed.json");
+        const StrokeScript s = loadStrokeScript(text, "keyed.json");
         const std::string once = formatStrokeScript(s);
-        EXPECT_EQ(formatStrokeScript(parseStrokeScript(once, "again.json")), once);
+        EXPECT_EQ(formatStrokeScript(loadStrokeScript(once, "again.json")), once);
     }
     const auto refusal = [](std::string text, const std::string& from, const std::string& to) {
         text.replace(text.find(from), from.size(), to);
         try {
-            parseStrokeScript(text, "bad.json");
+            loadStrokeScript(text, "bad.json");
         } catch (const ScriptError& e) {
             return std::string(e.what());
         }
@@ -366,8 +366,8 @@ TEST(Film, AnEditedKeyChangesOnlyTheFramesItShapes) {
     edited.replace(edited.find(key1), key1.size(), R"({ "time": 0.2, "t": [0.6, 0.2, 0] })");
     FilmTiming timing;
     timing.fps = 10.0;
-    const auto before = play(parseStrokeScript(text, "six.json"), timing);
-    const auto after = play(parseStrokeScript(edited, "edited.json"), timing);
+    const auto before = play(loadStrokeScript(text, "six.json"), timing);
+    const auto after = play(loadStrokeScript(edited, "edited.json"), timing);
     ASSERT_EQ(before.size(), 11u);
     ASSERT_EQ(after.size(), 11u);
     for (std::size_t n : {2, 3, 4, 6})
@@ -377,8 +377,8 @@ TEST(Film, AnEditedKeyChangesOnlyTheFramesItShapes) {
     // What the frames are made of, as `animate` stamps them: key 1 reaches frames 2 to 6
     // (0.1 to 0.5 s: the spline pieces from key 0 to key 3), so every frame that changed
     // has another digest, and the frames from key 3 on keep theirs.
-    const auto was = frameDigests(text, parseStrokeScript(text, "six.json"), timing);
-    const auto is = frameDigests(edited, parseStrokeScript(edited, "edited.json"), timing);
+    const auto was = frameDigests(text, loadStrokeScript(text, "six.json"), timing);
+    const auto is = frameDigests(edited, loadStrokeScript(edited, "edited.json"), timing);
     ASSERT_EQ(was.size(), 12u);
     ASSERT_EQ(is.size(), 12u);
     for (std::size_t n = 1; n <= 11; ++n) {
@@ -389,6 +389,5 @@ TEST(Film, AnEditedKeyChangesOnlyTheFramesItShapes) {
         }
     }
     // Another fog grid in the files, another digest.
-    EXPECT_NE(frameDigests(text, parseStrokeScript(text, "six.json"), timing, "density")[7],
-              was[7]);
+    EXPECT_NE(frameDigests(text, loadStrokeScript(text, "six.json"), timing, "density")[7], was[7]);
 }

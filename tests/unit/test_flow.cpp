@@ -43,7 +43,7 @@ std::string refusal(const std::string& stroke) {
         "strokes": [)" + stroke +
                              "]}";
     try {
-        parseStrokeScript(text, "flow.json");
+        loadStrokeScript(text, "flow.json");
     } catch (const ScriptError& e) {
         return e.what();
     }
@@ -153,7 +153,7 @@ TEST(FlowStroke, RoundTripsAndBadFlowsAreRefused) {
           {"type": "flow", "field": {"rotation": {"center": [0, 0, 0], "axis": [0, 0, 1],
             "degrees_per_second": 45, "radius": 1, "falloff": 0.5}}, "from": 1, "to": 2,
             "segments": 3}]})";
-    const StrokeScript s = parseStrokeScript(text, "flow.json");
+    const StrokeScript s = loadStrokeScript(text, "flow.json");
     ASSERT_EQ(s.strokes.size(), 2u);
     const auto& a = std::get<FlowStroke>(s.strokes[0]);
     EXPECT_EQ(a.field.kind, FieldSpec::Kind::Enright);
@@ -162,7 +162,7 @@ TEST(FlowStroke, RoundTripsAndBadFlowsAreRefused) {
     EXPECT_EQ(b.field.kind, FieldSpec::Kind::Rotation);
     EXPECT_EQ(b.segments, 3);
     EXPECT_DOUBLE_EQ(b.field.degreesPerSecond, 45.0);
-    EXPECT_EQ(formatStrokeScript(parseStrokeScript(formatStrokeScript(s), "again.json")),
+    EXPECT_EQ(formatStrokeScript(loadStrokeScript(formatStrokeScript(s), "again.json")),
               formatStrokeScript(s));
 
     EXPECT_EQ(refusal(R"({"type": "flow", "field": "enright", "from": 2, "to": 1})"),

@@ -103,7 +103,7 @@ TEST(Flow, ARotationSampledInAVdbFileTurnsTheShapeAsTheFieldDoes) {
                 }
         const std::string file = dir + (staggered ? "/turn_staggered.vdb" : "/turn.vdb");
         writeVelocity(s, file, "v");
-        const StrokeScript script = parseStrokeScript(
+        const StrokeScript script = loadStrokeScript(
             R"({"sweepers": 1, "start": {"sphere": {"center": [0, 0, 0], "radius": 1}},
                 "strokes": [{"type": "flow", "field": {"vdb": ")" +
                 file + R"(", "grid": "v"}, "from": 0, "to": 1}]})",

@@ -70,7 +70,7 @@ class HistoryCheck {
     std::vector<Failure> run() {
         StrokeScript script;
         try {
-            script = parseStrokeScript(history_.dump(), "history", dir_);
+            script = loadStrokeScript(history_.dump(), "history", dir_);
         } catch (const std::exception& e) {
             return {{"valid", e.what()}};
         }
@@ -380,7 +380,7 @@ TEST(RandomGestures, TheRecordedScriptIsWhatTheModelerSculpted) {
         const std::string said = ctl.takeMessage();
         std::vector<std::string> failures;
         const StrokeScript recorded =
-            parseStrokeScript(formatStrokeScript(doc.script()), "recorded gestures");
+            loadStrokeScript(formatStrokeScript(doc.script()), "recorded gestures");
         if (const std::size_t d = test::differingBits(*applyScript(recorded, "."), doc.grid()))
             failures.push_back("the recorded script applies to a grid " + std::to_string(d) +
                                " voxels off");

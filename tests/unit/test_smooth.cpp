@@ -144,7 +144,7 @@ TEST(Smooth, TheWrittenStrokeReplaysToTheSameGrid) {
     StrokeScript script;
     script.grid.voxelSize = kH;
     script.strokes = {stroke};
-    const StrokeScript back = parseStrokeScript(formatStrokeScript(script), "smooth.json", ".");
+    const StrokeScript back = loadStrokeScript(formatStrokeScript(script), "smooth.json", ".");
     ASSERT_EQ(back.strokes.size(), 1u);
     const auto* read = std::get_if<SmoothStroke>(&back.strokes[0]);
     ASSERT_NE(read, nullptr);

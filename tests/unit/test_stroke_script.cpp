@@ -9,6 +9,9 @@
 #include <gtest/gtest.h>
 
 #include "io/stroke_script.h"
+#include "io/vdb_file.h"
+#include "levelset/create.h"
+#include "scratch_dir.h"
 
 using namespace sweepers;
 namespace fs = std::filesystem;
@@ -35,7 +38,7 @@ const char* kFull = R"({
 
 std::string errorOf(const std::string& text) {
     try {
-        parseStrokeScript(text, "bad.json");
+        loadStrokeScript(text, "bad.json");
     } catch (const ScriptError& e) {
         return e.what();
     }
@@ -237,6 +240,60 @@ TEST(StrokeScript, TopologyToolsRoundTrip) {
     // A pinch is its needles' segments and the pull; a strangle, the noose's and the pull.
     EXPECT_EQ(segmentCount(a.strokes[0], 1.0 / 32), 14u);
     EXPECT_GT(segmentCount(a.strokes[1], 1.0 / 32), 2u);
+}
+
+// Parsing is data only: a script naming files that are not there parses, its baked tool and
+// sampled field unloaded and no fluid solved (no cache made); loading its inputs reads what
+// it names and refuses the script at the JSON location of what cannot be made, including a
+// baked tool's motion, whose sub-steps need the tool's shape.
+TEST(StrokeScript, ParsingTouchesNoDiskLoadingReadsWhatItNames) {
+    const test::ScratchDir dir;
+    const char* had = std::getenv("SWEEPERS_CACHE");
+    const std::string before = had ? had : "";
+    ::setenv("SWEEPERS_CACHE", (dir / "cache").c_str(), 1);
+    const auto tool = [](const std::string& file, const std::string& turn) {
+        return withStroke(R"({"type": "sweep", "tools": [{"shape": {"vdb": ")" + file +
+                          R"("}, "size": 0.3, "falloff": 0.3, "path": [{"t": [0, 1, 0]},
+                          {"t": [0, 1.2, 0], "r": [0, 0, 1, )" +
+                          turn + "]}]}]}");
+    };
+    const std::string field =
+        withStroke(R"({"type": "flow", "field": {"vdb": "field.vdb"}, "from": 0, "to": 1})");
+    const std::string fluid =
+        withStroke(R"({"type": "fluid", "radius": 0.3, "path": [[0, 0.85, 0], [0, 1, 0]]})");
+    const StrokeScript a = parseStrokeScript(tool("tool.vdb", "10"), "a.json");
+    EXPECT_FALSE(std::get<SweepStroke>(a.strokes[0]).tools[0].baked);
+    EXPECT_FALSE(std::get<FlowStroke>(parseStrokeScript(field, "b.json").strokes[0]).field.sampled);
+    EXPECT_FALSE(std::get<FluidStroke>(parseStrokeScript(fluid, "c.json").strokes[0]).fluid);
+    EXPECT_FALSE(fs::exists(dir / "cache"));
+    const auto refusal = [&](const std::string& text) {
+        try {
+            loadStrokeScript(text, "s.json", dir.path.string());
+        } catch (const ScriptError& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(refusal(tool("tool.vdb", "10")).rfind("s.json: /strokes/0/tools/0/shape: ", 0), 0u)
+        << refusal(tool("tool.vdb", "10"));
+    EXPECT_EQ(refusal(field).rfind("s.json: /strokes/0/field/vdb: ", 0), 0u) << refusal(field);
+    // The tool there: loading it plans its sweep, and a turn past 179 degrees is refused then.
+    writeLevelSet(*makeSphere(Eigen::Vector3d::Zero(), 1.0, 1.0 / 8, 3.0), dir / "tool.vdb");
+    EXPECT_EQ(refusal(tool("tool.vdb", "10")), "");
+    EXPECT_NO_THROW(parseStrokeScript(tool("tool.vdb", "179.5"), "d.json"));
+    EXPECT_EQ(refusal(tool("tool.vdb", "179.5")).rfind("s.json: /strokes/0/tools/0/path/1: ", 0),
+              0u)
+        << refusal(tool("tool.vdb", "179.5"));
+    // A ball's sweep needs no file: the same turn is refused when parsed.
+    EXPECT_THROW(parseStrokeScript(withStroke(R"({"type": "sweep", "tools": [{"shape": "ball",
+        "size": 0.3, "falloff": 0.3, "path": [{"t": [0, 1, 0]},
+        {"t": [0, 1.2, 0], "r": [0, 0, 1, 179.5]}]}]})"),
+                                   "e.json"),
+                 ScriptError);
+    if (had)
+        ::setenv("SWEEPERS_CACHE", before.c_str(), 1);
+    else
+        ::unsetenv("SWEEPERS_CACHE");
 }
 
 TEST(StrokeScript, MissingFileIsAScriptError) {

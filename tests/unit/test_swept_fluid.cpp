@@ -96,7 +96,7 @@ std::string fluidRefusal(const std::string& stroke) {
         "start": {"sphere": {"center": [0, 0, 0], "radius": 1}}, "strokes": [)" +
                              stroke + "]}";
     try {
-        parseStrokeScript(text, "fluid.json");
+        loadStrokeScript(text, "fluid.json");
     } catch (const ScriptError& e) {
         return e.what();
     }
@@ -265,7 +265,7 @@ TEST(SweptFluid, ScriptsReadAndWriteFluidStrokesAndRefuseBadOnes) {
     const std::string good = R"({"type": "fluid", "radius": 0.3,
                                  "path": [[0, 0.85, 0], [0, 1.15, 0], [0.1, 1.3, 0]]})";
     EXPECT_EQ(fluidRefusal(good), "");
-    const StrokeScript s = parseStrokeScript(
+    const StrokeScript s = loadStrokeScript(
         R"({"sweepers": 1, "start": {"sphere": {"center": [0, 0, 0], "radius": 1}}, "strokes": [)" +
             good + "]}",
         "fluid.json");
@@ -273,7 +273,7 @@ TEST(SweptFluid, ScriptsReadAndWriteFluidStrokesAndRefuseBadOnes) {
     EXPECT_EQ(f.path.size(), 3u);
     ASSERT_TRUE(f.fluid);
     EXPECT_EQ(segmentCount(s.strokes[0], 0.02), 2u);
-    const StrokeScript again = parseStrokeScript(formatStrokeScript(s), "again.json");
+    const StrokeScript again = loadStrokeScript(formatStrokeScript(s), "again.json");
     EXPECT_EQ(std::get<FluidStroke>(again.strokes.at(0)).path, f.path);
     EXPECT_EQ(std::get<FluidStroke>(again.strokes.at(0)).radius, 0.3);
     EXPECT_NE(fluidRefusal(R"({"type": "fluid", "radius": 0.3, "path": [[0, 1, 0]]})")
