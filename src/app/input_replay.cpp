@@ -32,6 +32,53 @@ int keyCode(const std::string& k) {
     return it->second;
 }
 
+// One event of a replay file (its frame checked against the one before by the caller).
+InputEvent readEvent(const nlohmann::json& e) {
+    InputEvent ev;
+    ev.frame = e.at("frame").get<int>();
+    const std::string type = e.at("type").get<std::string>();
+    auto number = [&](const char* k) {
+        const double v = e.at(k).get<double>();
+        if (!std::isfinite(v)) throw std::runtime_error(std::string(k) + " is not finite");
+        return v;
+    };
+    if (type == "press" || type == "release") {
+        ev.type = type == "press" ? InputEvent::Type::Press : InputEvent::Type::Release;
+        const std::string b = e.value("button", "left");
+        if (b == "left")
+            ev.button = 0;
+        else if (b == "right")
+            ev.button = 1;
+        else if (b == "middle")
+            ev.button = 2;
+        else
+            throw std::runtime_error("unknown button \"" + b + "\"");
+        ev.x = number("x");
+        ev.y = number("y");
+        ev.ctrl = e.value("ctrl", false);   // ctrl + left: the tool inverted
+        ev.shift = e.value("shift", false); // shift + left: smooth
+    } else if (type == "move") {
+        ev.type = InputEvent::Type::Move;
+        ev.x = number("x");
+        ev.y = number("y");
+    } else if (type == "key") {
+        ev.type = InputEvent::Type::Key;
+        ev.key = keyCode(e.at("key").get<std::string>());
+        ev.ctrl = e.value("ctrl", false);
+        ev.shift = e.value("shift", false);
+    } else if (type == "scroll") {
+        ev.type = InputEvent::Type::Scroll;
+        ev.dy = number("dy");
+        ev.ctrl = e.value("ctrl", false); // ctrl + wheel: tool radius
+    } else if (type == "drop") {
+        ev.type = InputEvent::Type::Drop;
+        ev.path = e.at("path").get<std::string>();
+    } else {
+        throw std::runtime_error("unknown type \"" + type + "\"");
+    }
+    return ev;
+}
+
 } // namespace
 
 InputReplay readInputReplay(const std::string& path) {
@@ -64,50 +111,9 @@ InputReplay readInputReplay(const std::string& path) {
         const auto& e = doc["events"][i];
         const std::string where = path + ": /events/" + std::to_string(i) + ": ";
         try {
-            InputEvent ev;
-            ev.frame = e.at("frame").get<int>();
+            const InputEvent ev = readEvent(e);
             if (ev.frame < lastFrame) throw std::runtime_error("frames must not go back");
             lastFrame = ev.frame;
-            const std::string type = e.at("type").get<std::string>();
-            auto number = [&](const char* k) {
-                const double v = e.at(k).get<double>();
-                if (!std::isfinite(v)) throw std::runtime_error(std::string(k) + " is not finite");
-                return v;
-            };
-            if (type == "press" || type == "release") {
-                ev.type = type == "press" ? InputEvent::Type::Press : InputEvent::Type::Release;
-                const std::string b = e.value("button", "left");
-                if (b == "left")
-                    ev.button = 0;
-                else if (b == "right")
-                    ev.button = 1;
-                else if (b == "middle")
-                    ev.button = 2;
-                else
-                    throw std::runtime_error("unknown button \"" + b + "\"");
-                ev.x = number("x");
-                ev.y = number("y");
-                ev.ctrl = e.value("ctrl", false);   // ctrl + left: the tool inverted
-                ev.shift = e.value("shift", false); // shift + left: smooth
-            } else if (type == "move") {
-                ev.type = InputEvent::Type::Move;
-                ev.x = number("x");
-                ev.y = number("y");
-            } else if (type == "key") {
-                ev.type = InputEvent::Type::Key;
-                ev.key = keyCode(e.at("key").get<std::string>());
-                ev.ctrl = e.value("ctrl", false);
-                ev.shift = e.value("shift", false);
-            } else if (type == "scroll") {
-                ev.type = InputEvent::Type::Scroll;
-                ev.dy = number("dy");
-                ev.ctrl = e.value("ctrl", false); // ctrl + wheel: tool radius
-            } else if (type == "drop") {
-                ev.type = InputEvent::Type::Drop;
-                ev.path = e.at("path").get<std::string>();
-            } else {
-                throw std::runtime_error("unknown type \"" + type + "\"");
-            }
             out.events.push_back(ev);
         } catch (const nlohmann::json::exception& x) {
             throw std::runtime_error(where + x.what());

@@ -49,9 +49,9 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
     if (!doc_) return;
     cursorX_ = x;
     cursorY_ = y;
-    if (sizing_ != Sizing::None) {
+    if (sizing_) {
         // The click that ends F or Shift-F keeps what the mouse set; it sculpts nothing.
-        if (press && button == 0) sizing_ = Sizing::None;
+        if (press && button == 0) sizing_.reset();
         return;
     }
     if (!press) {
@@ -66,63 +66,33 @@ void SculptController::onButton(int button, bool press, double x, double y, bool
         return;
     }
     if (busy() || drag_ == DragKind::Sculpt) return;
-    pressX_ = lastX_ = x;
-    pressY_ = lastY_ = y;
+    lastX_ = x;
+    lastY_ = y;
     if (button == 1 || button == 2) {
         drag_ = DragKind::Pan;
         return;
     }
-    mode_ = shift ? SculptMode::Smooth : settings_.mode;
-    inverted_ = ctrl;
     const auto hit = sculpting_ ? pick(x, y) : std::nullopt;
     if (!hit) {
         drag_ = DragKind::Orbit;
         return;
     }
-    grab_ = *hit;
-    axis_ = glm::normalize(camera_.eye() - camera_.target);
-    last_ = placementAt(x, y);
+    pressOnShape(shift, ctrl, *hit);
+}
+
+// A left press on the shape: the gesture of the tool (smoothing with Shift, whatever the
+// tool; Ctrl inverts it) begins its edit.
+void SculptController::pressOnShape(bool smooth, bool ctrl, const glm::dvec3& at) {
+    const SculptMode mode = smooth ? SculptMode::Smooth : settings_.mode;
+    gesture_ = makeGesture(mode, Press{at, cursorX_, cursorY_, ctrl});
     drag_ = DragKind::Sculpt;
     pending_ = false;
     stop_.reset();
-    if (topologyMode()) {
-        beginTopologyDrag();
-        return;
+    pendingSince_ = Clock::now(); // a dab's latency counts from the press
+    if (const auto refused = gesture_->press(working())) {
+        message_ = *refused;
+        stopDrag();
     }
-    if (mode_ == SculptMode::Swirl || mode_ == SculptMode::Fluid || dabMode()) {
-        doc_->beginEdit();
-        if (dabMode()) {
-            pendingSince_ = Clock::now();
-            mode_ == SculptMode::Clay ? dab(grab_) : smoothDab(grab_);
-        }
-        return;
-    }
-    ToolSpec tool;
-    tool.shape = ToolShapeKind::Ball;
-    tool.size = Eigen::Vector3d::Constant(settings_.radius);
-    tool.falloff = settings_.falloff;
-    tool.path = {last_};
-    if (settings_.bakedTool && mode_ != SculptMode::Inflate) {
-        // The baked tool at the size the radius asks (its own half-size is 1), with a band
-        // for this falloff (loaded again only when the falloff outgrows the last band).
-        tool.shape = ToolShapeKind::Baked;
-        tool.source = settings_.bakedSource;
-        tool.size = Eigen::Vector3d::Constant(settings_.radius / settings_.bakedRadius);
-        try {
-            tool.baked =
-                loadBakedTool(tool.source, "", tool.size.x(), tool.falloff / tool.size.x());
-        } catch (const std::exception& e) {
-            message_ = e.what();
-            drag_ = DragKind::None;
-            return;
-        }
-    }
-    SweepStroke stroke;
-    stroke.mirror = settings_.mirror;
-    stroke.tools = {tool};
-    stroke.strength = settings_.strength;
-    stroke.radial = radial();
-    doc_->beginStroke(stroke);
 }
 
 RadialSymmetry SculptController::radial() const {
@@ -149,120 +119,30 @@ void SculptController::useBall() {
     settings_.bakedTool.reset();
 }
 
-// Pinch and strangle: the press finds where the view ray leaves the shape again; the
-// stroke is set up between the two sides.
-void SculptController::beginTopologyDrag() {
-    const glm::dvec3 dir = glm::normalize(grab_ - camera_.eye());
-    const auto out =
-        exitLevelSet(doc_->grid(), toEigen3(grab_), toEigen3(dir), 1e3 * camera_.distance);
-    if (!out) {
-        message_ = "the view ray does not come out of the shape there";
-        drag_ = DragKind::None;
-        return;
-    }
-    through_ = 0.5 * (grab_ + toGlm(*out));
-    depth_ = glm::length(toGlm(*out) - grab_);
-    axis_ = dir;
-    applied_ = false;
-}
-
 std::optional<Stroke> SculptController::topologyStroke() const {
-    if (!doc_ || drag_ != DragKind::Sculpt || !topologyMode()) return std::nullopt;
-    const glm::dvec3 w =
-        camera_.dragInViewPlane(grab_, pressX_, pressY_, cursorX_, cursorY_, width_, height_);
-    const double h = doc_->grid().voxelSize()[0], f = settings_.falloff;
-    if (mode_ == SculptMode::Pinch) {
-        // The tips start half a falloff outside both sides; the drag opens the hole. The
-        // needles' funnels are as thin as their falloff allows: below about 13 voxels the
-        // grid loses them on axes off its own (measured on a unit sphere at 1/32: a plug
-        // stays for 10 voxels along (1, 1, 1), not for 12.8), so the falloff is at least 16.
-        PinchStroke s;
-        const double falloff = std::max(f, kMinPinchFalloffVoxels * h);
-        s.at = toEigen3(through_);
-        s.axis = toEigen3(axis_);
-        s.size = 0.5 * depth_ + 0.5 * falloff;
-        s.falloff = falloff;
-        s.open = std::max(glm::length(w), 2.0 * h);
-        return s;
-    }
-    // The drag goes across the limb: its length is the circle's radius, and with the view
-    // ray it spans the circle's plane.
-    if (glm::length(w) < 2.0 * h) return std::nullopt;
-    StrangleStroke s;
-    s.at = toEigen3(through_);
-    s.axis = toEigen3(glm::normalize(glm::cross(w, axis_)));
-    s.size = glm::length(w);
-    s.falloff = f;
-    s.open = settings_.radius;
-    return s;
+    if (!doc_ || drag_ != DragKind::Sculpt || !gesture_) return std::nullopt;
+    return gesture_->stroke(tools());
 }
 
-void SculptController::stepTopologyDrag() {
-    pending_ = false; // the preview follows the cursor by itself
-    if (!releasing_) return;
-    if (applied_) {
-        finishDrag(); // its work is done
-        return;
-    }
-    const std::optional<Stroke> stroke = topologyStroke();
-    if (!stroke) {
-        message_ = "drag across the limb: the drag's length is the strangling circle's radius";
-        drag_ = DragKind::None;
-        releasing_ = false;
-        return;
-    }
-    applied_ = true;
-    doc_->beginEdit();
-    Document* doc = doc_;
-    pendingSince_ = Clock::now();
-    launch([doc, st = *stroke] { return doc->applyStroke(st); });
+GestureTools SculptController::tools() const {
+    GestureTools t{*doc_,    camera_, settings_, radial(), cursorX_,
+                   cursorY_, width_,  height_,   {},       {}};
+    t.pick = [this](double x, double y) { return pick(x, y); };
+    return t;
 }
 
-// Clay mode: one inflation of the tool's radius (2.30) centred half a radius under the
-// surface point p (along the view ray), so that it adds the whole ball (a centre inside
-// the material gives the inserted ball its sign).
-// With Ctrl, a ball sucked back into its centre (2.31), which takes away the material
-// inside it: a whole radius under the surface, so that all of it is material and a dab
-// takes away what one adds. A dab's radial copies are dabs turned about the axis.
-void SculptController::dab(const glm::dvec3& p) {
-    const double depth = (inverted_ ? 1.0 : 0.5) * settings_.radius;
-    const glm::dvec3 in = p + depth * glm::normalize(p - camera_.eye());
-    InflateStroke stroke{toEigen3(in), settings_.radius};
-    stroke.strength = settings_.strength;
-    stroke.remove = inverted_;
-    stroke.radial = radial();
-    Document* doc = doc_;
-    launch([doc, stroke] { return doc->applyStroke(stroke); });
-    lastDab_ = p;
-    dabX_ = cursorX_;
-    dabY_ = cursorY_;
-}
-
-// One dab of smoothing centred on the surface point p, and its radial copies. (Smoothing
-// has no inverse worth having: sharpening is the heat equation run backward, which blows
-// up the finest noise first. Ctrl changes nothing.)
-void SculptController::smoothDab(const glm::dvec3& p) {
-    SmoothStroke stroke;
-    stroke.tool.size = Eigen::Vector3d::Constant(settings_.radius);
-    stroke.tool.falloff = settings_.falloff;
-    stroke.strength = settings_.smoothStrength;
-    stroke.radial = radial();
-    Placement at;
-    at.t = toEigen3(p);
-    stroke.tool.path = {at};
-    Document* doc = doc_;
-    launch([doc, stroke] { return doc->applyStroke(stroke); });
-    lastDab_ = p;
-    dabX_ = cursorX_;
-    dabY_ = cursorY_;
+GestureTools SculptController::working() {
+    GestureTools t = tools();
+    t.launch = [this](std::function<SegmentReport()> task) { launch(std::move(task)); };
+    return t;
 }
 
 void SculptController::onMove(double x, double y) {
     const double dx = x - lastX_, dy = y - lastY_;
     cursorX_ = x;
     cursorY_ = y;
-    if (sizing_ != Sizing::None) {
-        moveSizing(x, y);
+    if (sizing_) {
+        sizing_->move(x, y, camera_, width_, height_, settings_);
         lastX_ = x;
         lastY_ = y;
         return;
@@ -297,9 +177,9 @@ void SculptController::onScroll(double dy, bool ctrl) {
 KeyAction SculptController::onKey(int key, bool ctrl, bool shift) {
     if (!doc_) return KeyAction::None;
     if (key == GLFW_KEY_ESCAPE) {
-        if (sizing_ != Sizing::None) {
-            (sizing_ == Sizing::Radius ? settings_.radius : sizedStrength()) = sizingFrom_;
-            sizing_ = Sizing::None;
+        if (sizing_) {
+            sizing_->putBack(settings_);
+            sizing_.reset();
             return KeyAction::None;
         }
         if (busy()) cancel();
@@ -321,7 +201,9 @@ KeyAction SculptController::onKey(int key, bool ctrl, bool shift) {
     double& size = shift ? settings_.falloff : settings_.radius; // [ and ]: shift for falloff
     switch (key) {
     case 'F':
-        if (drag_ == DragKind::None) beginSizing(shift ? Sizing::Strength : Sizing::Radius);
+        if (drag_ == DragKind::None)
+            sizing_.emplace(shift ? Sizing::Strength : Sizing::Radius, cursorX_, cursorY_,
+                            pick(cursorX_, cursorY_).value_or(camera_.target), settings_);
         break;
     case GLFW_KEY_HOME:
         if (!busy()) frameView();
@@ -392,41 +274,9 @@ std::optional<glm::dvec3> SculptController::pick(double x, double y) const {
     return toGlm(*hit);
 }
 
-// F: the circle is drawn about the surface point under the cursor when F was pressed (or
-// the view's centre off the shape), and the mouse's distance from that point on the screen,
-// taken into the view plane there, is the radius. Shift-F: that distance over a fifth of
-// the window's height is the strength.
-void SculptController::beginSizing(Sizing what) {
-    sizing_ = what;
-    sizingX_ = cursorX_;
-    sizingY_ = cursorY_;
-    sizingAt_ = pick(cursorX_, cursorY_).value_or(camera_.target);
-    sizingFrom_ = what == Sizing::Radius ? settings_.radius : sizedStrength();
-}
-
-void SculptController::moveSizing(double x, double y) {
-    if (sizing_ == Sizing::Radius) {
-        const glm::dvec3 w =
-            camera_.dragInViewPlane(sizingAt_, sizingX_, sizingY_, x, y, width_, height_);
-        settings_.radius = std::clamp(glm::length(w), 0.02, 2.0);
-    } else {
-        // A fifth of the window's height is full strength: 1, or the smooth tool's most.
-        const double pixels = std::hypot(x - sizingX_, y - sizingY_);
-        const double most = settings_.mode == SculptMode::Smooth ? kMostSmoothStrength : 1.0;
-        sizedStrength() = std::clamp(most * pixels / (0.2 * height_), 0.01, most);
-    }
-}
-
-double& SculptController::sizedStrength() {
-    return settings_.mode == SculptMode::Smooth ? settings_.smoothStrength : settings_.strength;
-}
-
 std::optional<glm::dvec3> SculptController::toolCentre() const {
-    if (sizing_ != Sizing::None) return sizingAt_;
-    if (drag_ == DragKind::Sculpt) {
-        if (dabMode() || topologyMode()) return std::nullopt;
-        return toGlm(last_.t);
-    }
+    if (sizing_) return sizing_->at();
+    if (drag_ == DragKind::Sculpt) return gesture_ ? gesture_->toolCentre() : std::nullopt;
     if (drag_ == DragKind::None && !busy() && sculpting_) return pick(cursorX_, cursorY_);
     return std::nullopt;
 }
@@ -436,53 +286,6 @@ void SculptController::frameView() {
     const Box b = activeWorldBox(doc_->grid());
     camera_.frame(toGlm(b.min), toGlm(b.max));
     volume_ = doc_->mesher().enclosedVolume();
-}
-
-// The tool placement for the cursor at (x, y) during a drag, by mode; with Ctrl, the
-// hand's motion reversed (grab, swirl and fluid pull the other way, twist turns back,
-// inflate deflates).
-Placement SculptController::placementAt(double x, double y) const {
-    Placement p;
-    p.t = toEigen3(grab_);
-    const double sign = inverted_ ? -1.0 : 1.0;
-    switch (mode_) {
-    case SculptMode::Grab:
-    case SculptMode::Swirl:
-    case SculptMode::Fluid:
-    case SculptMode::Clay:
-    case SculptMode::Pinch:
-    case SculptMode::Strangle:
-    case SculptMode::Smooth:
-        p.t = toEigen3(grab_ +
-                       (topologyMode() ? 1.0 : sign) *
-                           camera_.dragInViewPlane(grab_, pressX_, pressY_, x, y, width_, height_));
-        break;
-    case SculptMode::Twist:
-        p.axis = toEigen3(axis_);
-        p.angleDegrees = sign * std::clamp(0.5 * (x - pressX_), -720.0, 720.0);
-        break;
-    case SculptMode::Inflate:
-        p.scale = Eigen::Vector3d::Constant(
-            std::exp(sign * std::clamp(-(y - pressY_), -400.0, 400.0) * 0.004));
-        break;
-    }
-    return p;
-}
-
-std::vector<Placement> SculptController::placementsTo(const Placement& target) const {
-    if (mode_ != SculptMode::Twist) return {target};
-    // The cursor gives an absolute angle; the hand's way from the last one is the
-    // difference, however large, cut into equal turns no larger than the limit.
-    const double turn = target.angleDegrees - last_.angleDegrees;
-    const int pieces = std::max(1, int(std::ceil(std::abs(turn) / kMaxTwistStepDegrees)));
-    std::vector<Placement> out;
-    for (int k = 1; k <= pieces; ++k) {
-        Placement p = target;
-        p.angleDegrees =
-            k == pieces ? target.angleDegrees : last_.angleDegrees + turn * double(k) / pieces;
-        out.push_back(p);
-    }
-    return out;
 }
 
 void SculptController::launch(std::function<SegmentReport()> task) {
@@ -503,14 +306,12 @@ void SculptController::collect() {
         finished_ = Finished{work_.get(), workSince_};
     } catch (const Cancelled&) {
         // The document has put the edit back already.
-        drag_ = DragKind::None;
-        releasing_ = pending_ = false;
+        stopDrag();
         volume_ = doc_->mesher().enclosedVolume();
         message_ = "the stroke was cancelled; the shape is as it was before it";
     } catch (const std::exception& e) {
         doc_->endEdit();
-        drag_ = DragKind::None;
-        releasing_ = pending_ = false;
+        stopDrag();
         message_ = e.what();
     }
 }
@@ -518,73 +319,35 @@ void SculptController::collect() {
 void SculptController::finishDrag() {
     doc_->endEdit();
     volume_ = doc_->mesher().enclosedVolume();
-    drag_ = DragKind::None;
-    releasing_ = false;
+    stopDrag();
 }
 
-// One piece of sculpting for the latest cursor position of a drag: a sweep segment (or a
-// few, for a fast twist), a swirl ring, a fluid push or a dab of clay.
+void SculptController::stopDrag() {
+    drag_ = DragKind::None;
+    gesture_.reset();
+    releasing_ = pending_ = false;
+}
+
+// One piece of sculpting for the latest cursor position of a drag (its gesture's: a sweep
+// segment or a few, a swirl ring, a fluid push, a dab), then, at the release, the drag's end.
 void SculptController::step() {
     collect();
     if (busy()) return;
     if (idle_) idle_();
     if (drag_ != DragKind::Sculpt) return;
-    if (topologyMode()) {
-        stepTopologyDrag();
-        return;
+    if (std::exchange(pending_, false) && gesture_->move(working())) return;
+    if (!releasing_) return;
+    pendingSince_ = Clock::now(); // a piece the release launches counts from here
+    switch (gesture_->release(working(), message_)) {
+    case Gesture::Release::Done:
+        finishDrag();
+        break;
+    case Gesture::Release::Launched:
+        break;
+    case Gesture::Release::Refused:
+        stopDrag();
+        break;
     }
-    if (pending_) {
-        pending_ = false;
-        Document* doc = doc_;
-        if (dabMode()) {
-            // A new dab of clay once the cursor has moved half a radius, of smoothing a
-            // quarter (in the view plane: the surface under a still cursor rises with every
-            // dab of clay).
-            const double moved = glm::length(camera_.dragInViewPlane(
-                lastDab_, dabX_, dabY_, cursorX_, cursorY_, width_, height_));
-            const double spacing = mode_ == SculptMode::Clay ? 0.5 : 0.25;
-            if (moved >= spacing * settings_.radius) {
-                if (const auto hit = pick(cursorX_, cursorY_)) {
-                    mode_ == SculptMode::Clay ? dab(*hit) : smoothDab(*hit);
-                    return;
-                }
-            }
-        } else if (const Placement p = placementAt(cursorX_, cursorY_); !(p == last_)) {
-            if (mode_ == SculptMode::Swirl) {
-                // A swirl ring carries the clay from the last position to this one.
-                SwirlStroke sw;
-                sw.at = last_.t;
-                sw.move = p.t - last_.t;
-                sw.radius = settings_.radius;
-                sw.strength = settings_.strength;
-                sw.radial = radial();
-                launch([doc, sw] { return doc->applyStroke(sw); });
-            } else if (mode_ == SculptMode::Fluid) {
-                // The ball pushes the clay as through a fluid from the last position to this
-                // one. The first fluid piece of a run finds the solution (from the cache, or
-                // a solve of a few seconds) on the worker, not in the window's thread.
-                FluidStroke fl;
-                fl.radius = settings_.radius;
-                fl.path = {last_.t, p.t};
-                fl.strength = settings_.strength;
-                launch([doc, fl]() mutable {
-                    fl.fluid = sweptFluid();
-                    return doc->applyStroke(fl);
-                });
-            } else {
-                const std::vector<Placement> path = placementsTo(p);
-                launch([doc, path] {
-                    SegmentReport r;
-                    for (const Placement& q : path)
-                        r = doc->extendStroke(q);
-                    return r;
-                });
-            }
-            last_ = p;
-            return;
-        }
-    }
-    if (releasing_) finishDrag();
 }
 
 namespace {

@@ -1,10 +1,10 @@
 // SPDX-License-Identifier: Apache-2.0
 // The modeler's input logic without a window: mouse, key and wheel events in (window
-// pixels, origin top left), camera moves and sculpting out. A drag on the shape becomes
-// tool placements, and each piece of sculpting (a sweep segment, a swirl ring, a dab of
-// clay, a dab of smoothing) runs on a worker thread while the window keeps drawing; moves
-// that arrive meanwhile coalesce into the next piece. The modeler feeds it GLFW's events; tests
-// feed it replay files and read the recorded script, with no window at all.
+// pixels, origin top left), camera moves and sculpting out. A drag on the shape is its tool's
+// gesture (app/gestures.h), and each piece of sculpting (a sweep segment, a swirl ring, a
+// dab of clay, a dab of smoothing) runs on a worker thread while the window keeps drawing;
+// moves that arrive meanwhile coalesce into the next piece. The modeler feeds it GLFW's
+// events; tests feed it replay files and read the recorded script, with no window at all.
 #pragma once
 
 #include <array>
@@ -19,79 +19,22 @@
 #include <glm/glm.hpp>
 
 #include "app/camera.h"
+#include "app/gestures.h"
 #include "app/input_replay.h"
+#include "app/tool_settings.h"
 #include "core/stopwatch.h"
 #include "document/document.h"
 #include "levelset/interrupt.h"
 
 namespace sweepers {
 
-// Grab, twist and inflate are sweeps (one segment per piece); swirl moves clay while
-// keeping its volume (one swirl ring per piece, 4.1), and so does fluid (the swept fluid of
-// 4.2, one fluid stroke per piece); clay adds material (Decaudin's
-// inflation, 2.30) under the cursor. Pinch and strangle change the topology (3.5): a drag
-// sets them up, shown as a preview, and the release applies the whole stroke. Smooth
-// relaxes the surface under the brush (levelset/smooth.h), one dab every quarter radius.
-enum class SculptMode { Grab, Twist, Inflate, Swirl, Fluid, Clay, Pinch, Strangle, Smooth };
-
-// Each mode's key and its name in the panel, in SculptMode's order: the key handler and the
-// panel both read this table.
-struct ModeInfo {
-    SculptMode mode;
-    int key;
-    const char* label;
-};
-inline constexpr std::array<ModeInfo, 9> kModes{{
-    {SculptMode::Grab, 'G', "Grab (G)"},
-    {SculptMode::Twist, 'T', "Twist (T)"},
-    {SculptMode::Inflate, 'I', "Inflate (I)"},
-    {SculptMode::Swirl, 'S', "Swirl, keeps volume (S)"},
-    {SculptMode::Fluid, 'U', "Fluid, keeps volume (U)"},
-    {SculptMode::Clay, 'C', "Add clay (C)"},
-    {SculptMode::Pinch, 'P', "Pinch a hole (P)"},
-    {SculptMode::Strangle, 'K', "Strangle (K)"},
-    {SculptMode::Smooth, 'O', "Smooth (O, Shift-drag)"},
-}};
 enum class DragKind { None, Sculpt, Orbit, Pan };
-
-struct ToolSettings {
-    SculptMode mode = SculptMode::Grab;
-    MirrorAxis mirror = MirrorAxis::None;
-    double radius = 0.25, falloff = 0.25;
-    // (0, 1]: the fraction of the hand's motion a grab, twist, inflate or fluid applies, of
-    // a swirl's move, of the clay ball's radius.
-    double strength = 1.0;
-    // (0, kMostSmoothStrength]: a smooth dab's flow time over the default dab's (Shift-drag
-    // smooths with it whatever the tool; a smooth dab is cheap enough to reach the form).
-    double smoothStrength = 1.0;
-    // Radial symmetry: `radialCount` copies of a grab, twist or inflate tool (and of each
-    // swirl ring and dab of clay or smoothing) turned about the axis `radialAxis` (0 x, 1 y,
-    // 2 z) through the origin; 1 is the tool alone.
-    int radialCount = 1, radialAxis = 1;
-    bool wireframe = false;
-    // Grab and twist move this shape instead of a ball when set (a baked tool, 3.4.3),
-    // scaled by `radius` over its own half-size `bakedRadius`.
-    std::shared_ptr<const ToolShape> bakedTool;
-    BakedToolSource bakedSource;
-    double bakedRadius = 1.0;
-};
-
-// F and Shift-F: the radius, or the strength, set by moving the mouse (a circle on the
-// screen), a click to keep it, Esc to put it back.
-enum class Sizing { None, Radius, Strength };
 
 // What a key asks of the window beyond the controller's own state.
 enum class KeyAction { None, Save, Cancel };
 
 class SculptController {
   public:
-    // Twist drags are cut into placements at most this far apart, so that every segment
-    // turns the way the hand went, however fast it went (a segment's motion is the
-    // logarithm of the relative placement, which takes the short way round).
-    static constexpr double kMaxTwistStepDegrees = 60.0;
-    // A pinch's falloff is at least this many voxels (see topologyStroke).
-    static constexpr double kMinPinchFalloffVoxels = 16.0;
-
     // waitEachPiece: every piece of sculpting is finished, on the caller's thread, before the
     // next event is taken (replays and tests: deterministic); otherwise pieces run on a
     // worker thread and events coalesce while one runs.
@@ -139,7 +82,7 @@ class SculptController {
     const ToolSettings& settings() const { return settings_; }
     DragKind drag() const { return drag_; }
     // F or Shift-F in progress: what the mouse sets, and where its circle is drawn.
-    Sizing sizing() const { return sizing_; }
+    Sizing sizing() const { return sizing_ ? sizing_->what() : Sizing::None; }
     // Where the tool is drawn: during a drag its current placement, else under the cursor.
     std::optional<glm::dvec3> toolCentre() const;
     // The surface point under a window pixel.
@@ -171,26 +114,16 @@ class SculptController {
     std::string takeMessage() { return std::exchange(message_, std::string()); }
 
   private:
-    Placement placementAt(double x, double y) const;
-    // The placements from the last one to `target`, each step small enough (twist).
-    std::vector<Placement> placementsTo(const Placement& target) const;
+    // What the drag's gesture may use: tools() to read, working() to launch pieces too.
+    GestureTools tools() const;
+    GestureTools working();
     void launch(std::function<SegmentReport()> task);
     void collect();
-    void dab(const glm::dvec3& p);
-    void smoothDab(const glm::dvec3& p);
     // The radial symmetry the panel sets (about an axis through the origin).
     RadialSymmetry radial() const;
-    void beginSizing(Sizing what);
-    void moveSizing(double x, double y);
-    // The strength Shift-F sets: the smooth tool's own, or every other tool's.
-    double& sizedStrength();
+    void pressOnShape(bool smooth, bool ctrl, const glm::dvec3& at);
     void finishDrag();
-    bool topologyMode() const {
-        return mode_ == SculptMode::Pinch || mode_ == SculptMode::Strangle;
-    }
-    bool dabMode() const { return mode_ == SculptMode::Clay || mode_ == SculptMode::Smooth; }
-    void beginTopologyDrag();
-    void stepTopologyDrag();
+    void stopDrag(); // without finishing: the drag ends where it failed
 
     Document* doc_ = nullptr;
     bool waitEach_ = false, sculpting_ = true;
@@ -199,20 +132,11 @@ class SculptController {
     OrbitCamera camera_;
     ToolSettings settings_;
     DragKind drag_ = DragKind::None;
-    SculptMode mode_ = SculptMode::Grab; // of the drag in progress
-    bool inverted_ = false;              // Ctrl held at its press
-    Sizing sizing_ = Sizing::None;
-    double sizingX_ = 0, sizingY_ = 0, sizingFrom_ = 0;
-    glm::dvec3 sizingAt_{0.0};
+    std::unique_ptr<Gesture> gesture_; // of the sculpting drag in progress
+    std::optional<ToolSizing> sizing_; // F or Shift-F in progress
+    // A move not yet sculpted (and since when), the release waiting for the last piece.
     bool pending_ = false, releasing_ = false;
-    double pressX_ = 0, pressY_ = 0, lastX_ = 0, lastY_ = 0, cursorX_ = -1, cursorY_ = -1;
-    glm::dvec3 grab_{0.0}, axis_{0, 0, 1}, lastDab_{0.0};
-    // Pinch and strangle: the middle of the shape along the view ray, and its depth there.
-    glm::dvec3 through_{0.0};
-    double depth_ = 0.0;
-    bool applied_ = false;
-    double dabX_ = 0, dabY_ = 0;
-    Placement last_;
+    double lastX_ = 0, lastY_ = 0, cursorX_ = -1, cursorY_ = -1;
     Clock::time_point pendingSince_, workSince_;
     std::future<SegmentReport> work_;
     FlagInterrupter stop_;

@@ -109,7 +109,7 @@ TEST(SculptController, AFastTwistTurnsTheWayTheHandWent) {
             const auto& path = s->tool().path;
             for (std::size_t i = 1; i < path.size(); ++i)
                 ASSERT_LT(std::abs(path[i].angleDegrees - path[i - 1].angleDegrees),
-                          SculptController::kMaxTwistStepDegrees + 1e-9)
+                          kMaxTwistStepDegrees + 1e-9)
                     << "placements " << i - 1 << " and " << i;
             EXPECT_DOUBLE_EQ(path.back().angleDegrees, std::min(0.5 * pixels, 720.0));
         }
@@ -296,7 +296,7 @@ TEST(SculptController, PinchModeGoesThroughTheShapeAlongTheView) {
     EXPECT_LT(pinch.at.norm(), h);
     EXPECT_LT((pinch.axis.normalized() + eye.normalized()).norm(), 1e-6);
     // At this coarse voxel size the falloff is raised to 16 voxels (0.25 asked).
-    EXPECT_EQ(pinch.falloff, SculptController::kMinPinchFalloffVoxels * h);
+    EXPECT_EQ(pinch.falloff, kMinPinchFalloffVoxels * h);
     EXPECT_NEAR(pinch.size, 1.0 + 0.5 * pinch.falloff, h);
     EXPECT_GE(strokePreview(*stroke).size(), 4u);
     EXPECT_TRUE(s.doc.script().strokes.empty()); // nothing applied before the release
