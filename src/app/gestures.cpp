@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "app/glm_eigen.h"
 #include "io/baked_tool.h"
 #include "io/fluid_cache.h"
 #include "levelset/raycast.h"
@@ -11,13 +12,6 @@
 namespace sweepers {
 
 namespace {
-
-glm::dvec3 toGlm(const Eigen::Vector3d& v) {
-    return {v.x(), v.y(), v.z()};
-}
-Eigen::Vector3d toEigen3(const glm::dvec3& v) {
-    return {v.x, v.y, v.z};
-}
 
 // The hand's motion since the press, in the view plane; with Ctrl, reversed.
 Placement translation(const GestureTools& t, const Press& p) {

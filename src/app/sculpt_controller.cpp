@@ -9,24 +9,13 @@
 #define GLFW_INCLUDE_NONE // key codes only: this file uses no window
 #include <GLFW/glfw3.h>
 
+#include "app/glm_eigen.h"
 #include "io/baked_tool.h"
-#include "io/fluid_cache.h"
 #include "io/mesh_file.h"
 #include "levelset/band.h"
 #include "levelset/raycast.h"
 
 namespace sweepers {
-
-namespace {
-
-glm::dvec3 toGlm(const Eigen::Vector3d& v) {
-    return {v.x(), v.y(), v.z()};
-}
-Eigen::Vector3d toEigen3(const glm::dvec3& v) {
-    return {v.x, v.y, v.z};
-}
-
-} // namespace
 
 void SculptController::setDocument(Document* doc) {
     wait();

@@ -39,32 +39,10 @@ assert [(p["type"], p["segment"]) for p in plan] == [("smooth", k) for k in rang
 assert abs(plan[4]["center"][0] - 0.3 * 3 ** 0.5 / 2) < 1e-12, plan[4]  # [0, 0.9, 0.3] turned 120'
 
 # check's plan is what apply runs (one planner makes both): on every data script and on a
-# script of the stroke kinds and options they lack, at a voxel size none of them has (pinch
-# and strangle plan their sub-steps by it).
-cat >"$tmp/kinds.json" <<'JSON'
-{"sweepers": 1, "grid": {"voxel_size": 0.04},
- "strokes": [
-  {"type": "swirl", "at": [0, 1, 0], "move": [0, 0.2, 0], "radius": 0.4,
-   "radial": {"count": 3, "axis": [0, 0, 1], "center": [0, 0, 0]}},
-  {"type": "swirl", "at": [1, 0, 0], "move": [0.2, 0, 0], "radius": 0.4, "ball": 0.15},
-  {"type": "inflate", "at": [0, 0, 1], "radius": 0.2,
-   "radial": {"count": 2, "axis": [0, 1, 0], "center": [0, 0, 0]}},
-  {"type": "inflate", "at": [0, -1, 0], "radius": 0.15, "remove": true},
-  {"type": "smooth", "strength": 0.5, "tool": {"shape": "ball", "size": 0.3, "falloff": 0.2,
-   "path": [{"t": [0, 1, 0]}, {"t": [0, 0.9, 0.3]}]}},
-  {"type": "flow", "from": 0, "to": 1, "segments": 2, "field": {"rotation": {"center": [0, 0, 0],
-   "axis": [0, 1, 0], "degrees_per_second": 30, "radius": 0.8, "falloff": 0.4}}},
-  {"type": "flow", "from": 0, "to": 0.5, "field": {"rotation": {"center": [0, 0, 0],
-   "axis": [1, 0, 0], "degrees_per_second": 20, "radius": 0.8, "falloff": 0.4}}},
-  {"type": "sweep", "strength": 0.5, "mirror": "x", "tools": [{"shape": "ellipsoid",
-   "size": [0.2, 0.3, 0.2], "falloff": 0.2, "path": [{"t": [0.5, 0.9, 0]},
-   {"t": [0.6, 1.3, 0], "r": [0, 0, 1, 20]}]}]},
-  {"type": "fluid", "radius": 0.3, "path": [[0, 0.85, 0], [0, 1.1, 0], [0.1, 1.3, 0]],
-   "strength": 0.5}
- ]}
-JSON
+# script of every stroke kind and the options whose plans differ, at a voxel size none of them
+# has (pinch and strangle plan their sub-steps by it).
 same=0
-for script in "$tmp/kinds.json" "$data"/*.json "$data"/animation/*.json "$data"/flows/*.json \
+for script in "$(dirname "$0")/every_stroke_kind.json" "$data"/*.json "$data"/animation/*.json "$data"/flows/*.json \
               "$data"/fluid/*.json "$data"/studies/*.json; do
   "$cli" check --json --voxel-size 0.05 "$script" >"$tmp/plan.json"
   "$cli" -q apply --stats --json --voxel-size 0.05 "$script" -o "$tmp/out.vdb" >"$tmp/ran.json" \

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "app/gestures.h"
+#include "app/glm_eigen.h"
 #include "levelset/raycast.h"
 
 using namespace sweepers;
@@ -31,10 +32,10 @@ struct Stage {
         };
         t.pick = [this](double px, double py) -> std::optional<glm::dvec3> {
             const Ray r = camera.rayThrough(px, py, kWidth, kHeight);
-            const auto hit = raycastLevelSet(doc.grid(), {r.origin.x, r.origin.y, r.origin.z},
-                                             {r.direction.x, r.direction.y, r.direction.z}, 100.0);
+            const auto hit =
+                raycastLevelSet(doc.grid(), toEigen3(r.origin), toEigen3(r.direction), 100.0);
             if (!hit) return std::nullopt;
-            return glm::dvec3(hit->x(), hit->y(), hit->z());
+            return toGlm(*hit);
         };
         return t;
     }

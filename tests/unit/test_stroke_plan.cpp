@@ -4,6 +4,7 @@
 // applies; the shape's decisions are left out of the plan ahead and only those.
 #include <gtest/gtest.h>
 
+#include "io/input_file.h"
 #include "io/stroke_script.h"
 #include "levelset/create.h"
 #include "sculpt/sculptor.h"
@@ -11,40 +12,14 @@
 
 using namespace sweepers;
 
-namespace {
-
-// Every stroke kind a script takes, with the options whose plans differ (radial copies, a
-// ball carried, a removal, segments given or not, mirror and strength); fluid strokes need
-// their solution and are compared on the data scripts (tests/cli/check.sh).
-const char* kKinds = R"({"sweepers": 1, "grid": {"voxel_size": 0.05}, "strokes": [
-  {"type": "sweep", "strength": 0.5, "mirror": "x", "radial": {"count": 2, "axis": [0, 1, 0], "center": [0, 0, 0]},
-   "tools": [{"shape": "ellipsoid", "size": [0.2, 0.3, 0.2], "falloff": 0.2,
-              "path": [{"t": [0.5, 0.9, 0]}, {"t": [0.6, 1.3, 0], "r": [0, 0, 1, 20]},
-                       {"t": [0.6, 1.5, 0]}]}]},
-  {"type": "swirl", "at": [0, 1, 0], "move": [0, 0.2, 0], "radius": 0.4,
-   "radial": {"count": 3, "axis": [0, 0, 1], "center": [0, 0, 0]}},
-  {"type": "swirl", "at": [1, 0, 0], "move": [0.2, 0, 0], "radius": 0.4, "ball": 0.15},
-  {"type": "inflate", "at": [0, 0, 1], "radius": 0.2,
-   "radial": {"count": 2, "axis": [0, 1, 0], "center": [0, 0, 0]}},
-  {"type": "inflate", "at": [0, -1, 0], "radius": 0.15, "remove": true},
-  {"type": "pinch", "at": [0, 0, 0], "axis": [0, 1, 0], "size": 1.25, "falloff": 0.4,
-   "open": 0.3},
-  {"type": "smooth", "radial": {"count": 2, "axis": [0, 1, 0], "center": [0, 0, 0]}, "tool": {"shape": "ball", "size": 0.3,
-   "falloff": 0.2, "path": [{"t": [0, 1, 0]}, {"t": [0, 0.9, 0.3]}, {"t": [0.1, 0.9, 0.3]}]}},
-  {"type": "flow", "from": 0, "to": 1, "segments": 2, "field": {"rotation": {"center": [0, 0, 0],
-   "axis": [0, 1, 0], "degrees_per_second": 30, "radius": 0.8, "falloff": 0.4}}},
-  {"type": "flow", "from": 0, "to": 0.5, "field": "vortex"},
-  {"type": "keyframed", "tool": {"shape": "ball", "size": 0.3, "falloff": 0.3},
-   "keys": [{"time": 0, "t": [0, 1, 0]}, {"time": 1, "t": [0, 1.3, 0]}]},
-  {"type": "slide", "tools": [{"shape": "ball", "size": 0.2, "falloff": 0.2,
-   "path": [{"t": [0, 0.9, 0]}, {"t": [0, 1.1, 0]}]}],
-   "keys": [{"time": 0, "t": [0, 0, 0]}, {"time": 1, "t": [0.2, 0, 0]}]}
-]})";
-
-} // namespace
-
 TEST(StrokePlan, AheadOfTheShapeItIsThePlanOnTheShapeWhereTheShapeDoesNotDecide) {
-    const StrokeScript script = parseStrokeScript(kKinds, "kinds.json");
+    // Every stroke kind, with the options whose plans differ (radial copies, a ball carried,
+    // a removal, segments given or not, mirror and strength); parsed only, so the fluid
+    // stroke, which needs its solution, is left to tests/cli/check.sh.
+    const std::string path = SWEEPERS_CLI_TEST_DIR "/every_stroke_kind.json";
+    StrokeScript script = parseStrokeScript(readWholeFile(path, 1 << 20, "a script"), path);
+    ASSERT_TRUE(std::holds_alternative<FluidStroke>(script.strokes.back()));
+    script.strokes.pop_back();
     const double h = script.grid.voxelSize;
     GridPtr grid = makeSphere(Eigen::Vector3d::Zero(), 1.0, h, 3.0);
     Sculptor sculptor(grid);
