@@ -21,37 +21,14 @@ namespace sweepers {
 
 namespace {
 
-const char* const kColumns[] = {"script",
-                                "variant",
-                                "voxel_size",
-                                "wall_s",
-                                "advect_s",
-                                "renorm_s",
-                                "mesh_s",
-                                "peak_rss_mb",
-                                "active_voxels",
-                                "volume",
-                                "volume_change_pct",
-                                "area",
-                                "euler",
-                                "genus",
-                                "components",
-                                "err_mean",
-                                "err_rms",
-                                "err_max",
-                                "err_rms_voxels",
-                                "sign_flips",
-                                "order_rms",
-                                "volume_ref",
-                                "volume_err",
-                                "order_volume",
-                                "ref_euler",
-                                "ref_genus",
-                                "ref_components",
-                                "err_samples",
-                                "unmatched",
-                                "threads",
-                                "host",
+const char* const kColumns[] = {"script",       "variant",       "voxel_size", "wall_s",
+                                "measure_s",    "advect_s",      "renorm_s",   "mesh_s",
+                                "peak_rss_mb",  "active_voxels", "volume",     "volume_change_pct",
+                                "area",         "euler",         "genus",      "components",
+                                "err_mean",     "err_rms",       "err_max",    "err_rms_voxels",
+                                "sign_flips",   "order_rms",     "volume_ref", "volume_err",
+                                "order_volume", "ref_euler",     "ref_genus",  "ref_components",
+                                "err_samples",  "unmatched",     "threads",    "host",
                                 "failure"};
 constexpr std::size_t kColumnCount = sizeof(kColumns) / sizeof(kColumns[0]);
 // The position of a column in kColumns.
@@ -322,6 +299,7 @@ std::vector<std::string> studyCells(const StudyRow& r, bool allDigits) {
             r.variant,
             number(r.voxelSize, 17),
             num(r.wallSeconds),
+            num(r.measureSeconds),
             num(r.advectSeconds),
             num(r.renormSeconds),
             num(r.meshSeconds),
@@ -374,6 +352,7 @@ StudyRow studyRowFromCells(const std::vector<std::string>& f, const std::string&
     r.failure = at("failure");
     if (!r.failure.empty()) return r;
     r.wallSeconds = real("wall_s");
+    r.measureSeconds = real("measure_s");
     r.advectSeconds = real("advect_s");
     r.renormSeconds = real("renorm_s");
     r.meshSeconds = real("mesh_s");
@@ -494,12 +473,12 @@ std::string tableOf(const std::vector<StudyRow>& rows) {
     std::ostringstream out;
     out << "| variant | voxel size | err RMS (voxels) | err max (voxels) | err RMS | order (RMS) "
            "| sign flips | volume error | order (volume) | volume change | Euler | genus "
-           "| components | time (s) |\n"
-        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+           "| components | time (s) | measuring (s) |\n"
+        << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
     for (const StudyRow& r : rows) {
         out << "| " << r.variant << " | 1/" << number(1.0 / r.voxelSize, 6) << " | ";
         if (!r.failure.empty()) {
-            out << "failed: " << r.failure << " | | | | | | | | | | | |\n";
+            out << "failed: " << r.failure << " | | | | | | | | | | | | |\n";
             continue;
         }
         out << number(voxelsOf(r), 3) << " | " << number(r.error.max / r.voxelSize, 3) << " | "
@@ -509,7 +488,7 @@ std::string tableOf(const std::vector<StudyRow>& rows) {
             << (std::isnan(r.orderVolume) ? "" : number(r.orderVolume, 3)) << " | "
             << number(r.volumeChangePct, 3) << "% | " << r.euler << " | " << r.genus << " | "
             << r.components << (changed(r) ? " (exact: " + topology(r) + ")" : "") << " | "
-            << number(r.wallSeconds, 3) << " |\n";
+            << number(r.wallSeconds, 3) << " | " << number(r.measureSeconds, 3) << " |\n";
     }
     return out.str();
 }
@@ -566,12 +545,13 @@ std::string studyReport(const std::vector<StudyRow>& rows, const std::vector<Stu
         out << "\n";
     }
     out << "## Where each run ran\n\n"
-        << "| run | host | threads | time (s) | peak memory (MB) | result |\n"
-        << "|---|---|---|---|---|---|\n";
+        << "| run | host | threads | time (s) | measuring (s) | peak memory (MB) | result |\n"
+        << "|---|---|---|---|---|---|---|\n";
     for (const StudyRow& r : rows)
         out << "| " << studyRunId(r) << " | " << r.host << " | "
             << (r.threads > 0 ? std::to_string(r.threads) : "") << " | "
             << (r.failure.empty() ? number(r.wallSeconds, 3) : "") << " | "
+            << (r.failure.empty() ? number(r.measureSeconds, 3) : "") << " | "
             << (r.failure.empty() ? number(r.peakRssMb, 4) : "") << " | "
             << (r.failure.empty() ? "done" : "failed") << " |\n";
     return out.str();

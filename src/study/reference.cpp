@@ -52,6 +52,15 @@ double ExactReference::value(const Eigen::Vector3d& x) const {
 }
 
 double ExactReference::valueThrough(std::size_t n, const Eigen::Vector3d& x) const {
+    std::vector<std::size_t> all(n);
+    for (std::size_t k = 0; k < n; ++k)
+        all[k] = n - 1 - k;
+    return *valueAlong(all, nullptr, x);
+}
+
+std::optional<double> ExactReference::valueAlong(const std::vector<std::size_t>& steps,
+                                                 const std::vector<Box>* after,
+                                                 const Eigen::Vector3d& x) const {
     // Each deformation turns the value found at a point's pre-image into the point's value: the
     // same value, except where it tears space (it adds how deep the point lies in what it
     // opened, tear.h) or fills it (an inflation's ball, from the value its centre had before
@@ -60,17 +69,21 @@ double ExactReference::valueThrough(std::size_t n, const Eigen::Vector3d& x) con
     Eigen::Vector3d p = x;
     if (!fills_) {
         double opened = 0.0;
-        for (std::size_t k = n; k-- > 0;) {
-            if (history_[k]->tears()) opened += std::max(0.0, history_[k]->openedDepth(p));
-            p = history_[k]->inverseMap(p);
+        for (std::size_t i = 0; i < steps.size(); ++i) {
+            const StepDeformation& seg = *history_[steps[i]];
+            if (seg.tears()) opened += std::max(0.0, seg.openedDepth(p));
+            p = seg.inverseMap(p);
+            if (after && !(*after)[i].contains(p)) return std::nullopt;
         }
         return start_(p) + opened;
     }
     std::vector<std::pair<std::size_t, Eigen::Vector3d>> turns; // latest first
-    for (std::size_t k = n; k-- > 0;) {
+    for (std::size_t i = 0; i < steps.size(); ++i) {
+        const std::size_t k = steps[i];
         const StepDeformation& seg = *history_[k];
         if (seg.tears() || (seg.fills() && seg.filledBox().contains(p))) turns.emplace_back(k, p);
         p = seg.inverseMap(p);
+        if (after && !(*after)[i].contains(p)) return std::nullopt;
     }
     double v = start_(p);
     for (auto it = turns.rbegin(); it != turns.rend(); ++it) {
@@ -81,9 +94,37 @@ double ExactReference::valueThrough(std::size_t n, const Eigen::Vector3d& x) con
     return v;
 }
 
-std::optional<Eigen::Vector3d> ExactReference::crossing(const Eigen::Vector3d& a,
-                                                        const Eigen::Vector3d& b,
-                                                        double tolerance) const {
+ExactReference::Near ExactReference::near(const Box& box) const {
+    Near n;
+    n.reference_ = this;
+    n.box_ = box;
+    // Back from the last deformation: one that is the identity on every point the box's points
+    // can be at by then is skipped (a tear or a fill is kept: its value changes even where it
+    // does not move the point); one that is not grows that bound by what it reaches, as its
+    // inverse keeps the points of its affected box inside it.
+    Box bound = box;
+    for (std::size_t k = history_.size(); k-- > 0;) {
+        const StepDeformation& seg = *history_[k];
+        if (!seg.tears() && !seg.fills() && seg.identityOn(bound)) continue;
+        bound.add(seg.affectedBox());
+        n.steps_.push_back(k);
+        n.after_.push_back(bound);
+    }
+    return n;
+}
+
+double ExactReference::Near::value(const Eigen::Vector3d& x) const {
+    if (box_.contains(x))
+        if (const auto v = reference_->valueAlong(steps_, &after_, x)) return *v;
+    return reference_->value(x); // a point that left the bound: the whole history
+}
+
+namespace {
+
+// The point of [a, b] where `value` changes sign, by bisection to `tolerance` along it.
+template <typename Value>
+std::optional<Eigen::Vector3d> bisect(const Value& value, const Eigen::Vector3d& a,
+                                      const Eigen::Vector3d& b, double tolerance) {
     double lo = 0.0, hi = 1.0;
     const double va = value(a), vb = value(b);
     if (va == 0.0) return a;
@@ -103,6 +144,20 @@ std::optional<Eigen::Vector3d> ExactReference::crossing(const Eigen::Vector3d& a
             hi = mid;
     }
     return a + 0.5 * (lo + hi) * (b - a);
+}
+
+} // namespace
+
+std::optional<Eigen::Vector3d> ExactReference::crossing(const Eigen::Vector3d& a,
+                                                        const Eigen::Vector3d& b,
+                                                        double tolerance) const {
+    return bisect([this](const Eigen::Vector3d& x) { return value(x); }, a, b, tolerance);
+}
+
+std::optional<Eigen::Vector3d> ExactReference::Near::crossing(const Eigen::Vector3d& a,
+                                                              const Eigen::Vector3d& b,
+                                                              double tolerance) const {
+    return bisect([this](const Eigen::Vector3d& x) { return value(x); }, a, b, tolerance);
 }
 
 } // namespace sweepers

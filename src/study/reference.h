@@ -14,6 +14,7 @@
 
 #include <Eigen/Core>
 
+#include "core/box.h"
 #include "deform/step_deformation.h"
 #include "vdb/vdb.h"
 
@@ -46,9 +47,37 @@ class ExactReference {
     std::optional<Eigen::Vector3d> crossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                             double tolerance) const;
 
+    // The history as the points of `box` see it (a leaf of a grid, a bracket around a mesh
+    // vertex): the deformations that are the identity on every point on the way back from
+    // the box (identityOn) are skipped, exactly; value and crossing give what the whole
+    // history gives, to the bit, and cost what the rest costs. A point that leaves the box's
+    // bound on its way back is taken through the whole history.
+    class Near {
+      public:
+        double value(const Eigen::Vector3d& x) const;
+        std::optional<Eigen::Vector3d> crossing(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                                double tolerance) const;
+        // The deformations kept, of the history's.
+        std::size_t size() const { return steps_.size(); }
+
+      private:
+        friend class ExactReference;
+        const ExactReference* reference_ = nullptr;
+        Box box_;
+        // The deformations kept, latest first, and after each the box every point of `box_`
+        // lies in on its way back (the box grown by what the deformation reaches).
+        std::vector<std::size_t> steps_;
+        std::vector<Box> after_;
+    };
+    Near near(const Box& box) const;
+
   private:
     // phi_ref(x) of the first n deformations of the history.
     double valueThrough(std::size_t n, const Eigen::Vector3d& x) const;
+    // phi_ref(x) through the deformations `steps` (latest first); nullopt when the point
+    // leaves the box its step allows (`after`, when given).
+    std::optional<double> valueAlong(const std::vector<std::size_t>& steps,
+                                     const std::vector<Box>* after, const Eigen::Vector3d& x) const;
 
     StartFunction start_;
     std::vector<std::shared_ptr<const StepDeformation>> history_;

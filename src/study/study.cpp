@@ -103,17 +103,26 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
     std::vector<LeafNode*> signLeaves;
     for (auto it = signs->tree().beginLeaf(); it; ++it)
         signLeaves.push_back(&*it);
+    // The history as a leaf's points see it (the identity elsewhere skipped, exactly), with
+    // the next voxel along each axis: the edges the crossings are looked for on.
+    const auto nearLeaf = [&](const LeafNode& leaf) {
+        const openvdb::CoordBBox b = leaf.getNodeBoundingBox();
+        return reference.near(Box(toEigen(grid.indexToWorld(b.min())),
+                                  toEigen(grid.indexToWorld(b.max().offsetBy(1)))));
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, signLeaves.size()), [&](const auto& r) {
         pollInterrupt(interrupter);
         Tally& t = tallies.local();
-        for (std::size_t l = r.begin(); l != r.end(); ++l)
+        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const ExactReference::Near near = nearLeaf(*signLeaves[l]);
             for (auto it = signLeaves[l]->beginValueOn(); it; ++it) {
                 const bool inside = *it < 0.0f;
-                const double v = reference.value(toEigen(grid.indexToWorld(it.getCoord())));
+                const double v = near.value(toEigen(grid.indexToWorld(it.getCoord())));
                 if ((v < 0.0) != inside) ++t.flips;
                 // Only the sign is kept; exact zeros count as outside, as in the grid.
                 it.setValue(v < 0.0 ? -1.0f : 1.0f);
             }
+        }
     });
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
         pollInterrupt(interrupter);
@@ -122,7 +131,8 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
         const Grid::ConstAccessor acc = grid.getConstAccessor(); // the sampler keeps a reference
         const openvdb::tools::GridSampler<Grid::ConstAccessor, openvdb::tools::BoxSampler> sampler(
             acc, grid.transform());
-        for (std::size_t l = r.begin(); l != r.end(); ++l)
+        for (std::size_t l = r.begin(); l != r.end(); ++l) {
+            const ExactReference::Near near = nearLeaf(*leaves[l]);
             for (auto it = leaves[l]->cbeginValueOn(); it; ++it) {
                 const openvdb::Coord ijk = it.getCoord();
                 const bool inside = refAcc.getValue(ijk) < 0.0f;
@@ -131,11 +141,12 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
                     next[a] += 1;
                     float other;
                     if (!refAcc.probeValue(next, other) || (other < 0.0f) == inside) continue;
-                    const auto c = reference.crossing(toEigen(grid.indexToWorld(ijk)),
-                                                      toEigen(grid.indexToWorld(next)), tolerance);
+                    const auto c = near.crossing(toEigen(grid.indexToWorld(ijk)),
+                                                 toEigen(grid.indexToWorld(next)), tolerance);
                     if (c) t.add(std::abs(double(sampler.wsSample(toVdb(*c)))));
                 }
             }
+        }
     });
 
     // Mesh to reference: the nearest bracket along the normal that holds a crossing.
@@ -149,9 +160,12 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
                 const Eigen::Vector3d n = i < mesh.normals.size()
                                               ? mesh.normals[i].cast<double>().normalized()
                                               : Eigen::Vector3d::UnitX();
+                const double most = InterfaceError::kSearchVoxels * h;
+                const ExactReference::Near near =
+                    reference.near(Box(p.array() - most, p.array() + most));
                 std::optional<Eigen::Vector3d> c;
                 for (int reach = 1; reach <= int(InterfaceError::kSearchVoxels) && !c; ++reach)
-                    c = reference.crossing(p - reach * h * n, p + reach * h * n, tolerance);
+                    c = near.crossing(p - reach * h * n, p + reach * h * n, tolerance);
                 onReference[i] = c ? *c : p;
                 if (c) {
                     t.add((*c - p).norm());
@@ -237,6 +251,7 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
     row.peakRssMb = peakResidentBytes() / double(1 << 20);
 
     run.grid = sculptor.gridPtr();
+    const auto t2 = Clock::now();
     const LevelSetMeasures m = measureLevelSet(*run.grid);
     row.activeVoxels = m.activeVoxels;
     row.volume = m.volume;
@@ -253,6 +268,7 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
         row.error.meshVolume = row.error.referenceVolume = none;
         row.referenceTopologyKnown = false;
     }
+    row.measureSeconds = secondsSince(t2);
     return run;
 }
 

@@ -57,6 +57,9 @@ struct StudyRow {
     std::string variant;
     double voxelSize = 0.0;
     double wallSeconds = 0.0, advectSeconds = 0.0, renormSeconds = 0.0, meshSeconds = 0.0;
+    // After the run: measuring its grid (volume, area, topology) and its error against the
+    // exact reference, which wallSeconds leaves out.
+    double measureSeconds = 0.0;
     // Peak resident memory during the run, its start grid included (the process's peak so
     // far where the kernel cannot restart the count).
     double peakRssMb = 0.0;

@@ -4,7 +4,7 @@ that say how long a run took, how much memory it used and where it ran."""
 import csv
 import sys
 
-WHERE_AND_HOW_LONG = {"wall_s", "advect_s", "renorm_s", "mesh_s", "peak_rss_mb", "threads",
+WHERE_AND_HOW_LONG = {"wall_s", "measure_s", "advect_s", "renorm_s", "mesh_s", "peak_rss_mb", "threads",
                       "host"}
 
 

@@ -183,3 +183,48 @@ TEST(ExactReference, AnInflationOnTheSurfaceFillsItsBallWithClay) {
         EXPECT_GT(ref.value(c + 1.02 * rho * Eigen::Vector3d::UnitY()), 0.0) << depth;
     }
 }
+
+// The history as a box's points see it skips the deformations that are the identity there,
+// and gives the whole history's value and crossings to the bit: on scripts of sweeps, swirls,
+// tears (pinch) and fills (an inflation), at random points of random small boxes near the
+// surface and across it; and it does skip (a drag's path is long, a box near one end meets
+// few of its segments).
+TEST(ExactReference, NearABoxItIsTheWholeHistoryToTheBit) {
+    const std::string inflate = R"({"sweepers": 1, "strokes": [
+      {"type": "inflate", "at": [0.3, 0.95, 0], "radius": 0.2},
+      {"type": "sweep", "tools": [{"shape": "ball", "size": 0.3, "falloff": 0.3,
+        "path": [{"t": [0.3, 1.1, 0]}, {"t": [0.5, 1.4, 0]}]}]}]})";
+    const std::string dir = std::string(SWEEPERS_DATA_DIR) + "/";
+    const std::vector<StrokeScript> scripts = {
+        readStrokeScript(dir + "drag.json"), readStrokeScript(dir + "starfish_swirls.json"),
+        readStrokeScript(dir + "pinch.json"), loadStrokeScript(inflate, "inflate.json")};
+    Rng rng(75);
+    std::size_t fewest = std::size_t(-1), points = 0;
+    for (const StrokeScript& script : scripts) {
+        const double h = 1.0 / 16;
+        Sculptor sculptor(makeSphere(script.start.center, script.start.radius, h, 3.0));
+        ExactReference ref(ExactReference::sphere(script.start.center, script.start.radius));
+        History history;
+        applyStrokes(sculptor, script.strokes, {}, {}, &history);
+        for (auto& d : history)
+            ref.append(std::move(d));
+        for (int b = 0; b < 60; ++b) {
+            // A box of 2 to 8 voxels about a point within half a unit of the unit sphere.
+            const Eigen::Vector3d dir = rng.unit();
+            const Eigen::Vector3d c = dir * rng.uniform(0.6, 1.6);
+            const double half = rng.uniform(1.0, 4.0) * h;
+            const Box box(c.array() - half, c.array() + half);
+            const ExactReference::Near near = ref.near(box);
+            fewest = std::min(fewest, near.size());
+            for (int i = 0; i < 20; ++i, ++points) {
+                const Eigen::Vector3d p = rng.inBox(box.min, box.max);
+                ASSERT_EQ(near.value(p), ref.value(p)) << "box " << b << " point " << i;
+            }
+            const Eigen::Vector3d a = box.min, z = box.max;
+            EXPECT_EQ(near.crossing(a, z, 1e-6 * h), ref.crossing(a, z, 1e-6 * h)) << b;
+        }
+    }
+    std::printf("[ near ] %zu points, the whole history's value to the bit; fewest kept %zu\n",
+                points, fewest);
+    EXPECT_LT(fewest, 10u); // of the drag's 100 segments, or a swirl history's 50
+}

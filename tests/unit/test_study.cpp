@@ -94,6 +94,7 @@ TEST(Study, ARunsResultReadsBackWhatWasWritten) {
                                   row("trilinear", 1.0 / 64, 1e-3)};
     rows[1].error.signFlips = 7;
     rows[1].wallSeconds = 1.0 / 3.0;
+    rows[1].measureSeconds = 2.0 / 3.0;
     rows[1].error.meshVolume = 0.5 - 2.5e-4;
     rows[1].host = "node-17";
     rows[1].threads = 8;
@@ -110,6 +111,7 @@ TEST(Study, ARunsResultReadsBackWhatWasWritten) {
     EXPECT_EQ(back[1].voxelSize, 1.0 / 64); // exactly: a result is matched to its run by it
     EXPECT_EQ(back[1].error.signFlips, 7u);
     EXPECT_EQ(back[1].wallSeconds, 1.0 / 3.0); // every digit, for the table made from it
+    EXPECT_EQ(back[1].measureSeconds, 2.0 / 3.0);
     EXPECT_EQ(back[1].host, "node-17");
     EXPECT_EQ(back[1].threads, 8);
     EXPECT_TRUE(std::isnan(back[0].orderRms));
