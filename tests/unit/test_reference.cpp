@@ -23,6 +23,16 @@ using sweepers::test::Rng;
 
 namespace {
 
+// Applies the script's strokes (from a sphere) with `sculptor`; the history's exact reference.
+ExactReference sculpted(Sculptor& sculptor, const StrokeScript& script) {
+    ExactReference ref(ExactReference::sphere(script.start.center, script.start.radius));
+    History history;
+    applyStrokes(sculptor, script.strokes, {}, {}, &history);
+    for (auto& d : history)
+        ref.append(std::move(d));
+    return ref;
+}
+
 Placement at(Eigen::Vector3d t, double degreesAboutZ = 0.0) {
     Placement p;
     p.t = t;
@@ -90,11 +100,7 @@ TEST(ExactReference, TwistedLimbAgreesWithTheGridWithinAVoxel) {
         readStrokeScript(std::string(SWEEPERS_DATA_DIR) + "/twisted_limb.json");
     const double h = 1.0 / 32.0;
     Sculptor sculptor(makeSphere(script.start.center, script.start.radius, h, 3.0));
-    ExactReference ref(ExactReference::sphere(script.start.center, script.start.radius));
-    History history;
-    applyStrokes(sculptor, script.strokes, {}, {}, &history);
-    for (auto& d : history)
-        ref.append(std::move(d));
+    const ExactReference ref = sculpted(sculptor, script);
     ASSERT_GT(ref.size(), 2u);
 
     const Grid& grid = sculptor.grid();
@@ -203,11 +209,7 @@ TEST(ExactReference, NearABoxItIsTheWholeHistoryToTheBit) {
     for (const StrokeScript& script : scripts) {
         const double h = 1.0 / 16;
         Sculptor sculptor(makeSphere(script.start.center, script.start.radius, h, 3.0));
-        ExactReference ref(ExactReference::sphere(script.start.center, script.start.radius));
-        History history;
-        applyStrokes(sculptor, script.strokes, {}, {}, &history);
-        for (auto& d : history)
-            ref.append(std::move(d));
+        const ExactReference ref = sculpted(sculptor, script);
         for (int b = 0; b < 60; ++b) {
             // A box of 2 to 8 voxels about a point within half a unit of the unit sphere.
             const Eigen::Vector3d dir = rng.unit();
