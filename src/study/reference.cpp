@@ -34,8 +34,8 @@ void ExactReference::append(std::shared_ptr<const StepDeformation> deformation) 
     if (!deformation) throw std::invalid_argument("ExactReference::append: no deformation");
     fills_ = fills_ || deformation->fills();
     // A fill's value at its centre before it, computed once: every point it fills reads it.
-    fromValues_.push_back(
-        deformation->fills() ? valueThrough(history_.size(), deformation->filledFrom()) : 0.0);
+    fromValues_.push_back(deformation->fills() ? value(deformation->filledFrom()) : 0.0);
+    latestFirst_.insert(latestFirst_.begin(), history_.size());
     history_.push_back(std::move(deformation));
 }
 
@@ -48,14 +48,7 @@ Eigen::Vector3d ExactReference::pullBack(const Eigen::Vector3d& x) const {
 }
 
 double ExactReference::value(const Eigen::Vector3d& x) const {
-    return valueThrough(history_.size(), x);
-}
-
-double ExactReference::valueThrough(std::size_t n, const Eigen::Vector3d& x) const {
-    std::vector<std::size_t> all(n);
-    for (std::size_t k = 0; k < n; ++k)
-        all[k] = n - 1 - k;
-    return *valueAlong(all, nullptr, x);
+    return *valueAlong(latestFirst_, nullptr, x);
 }
 
 std::optional<double> ExactReference::valueAlong(const std::vector<std::size_t>& steps,

@@ -72,8 +72,6 @@ class ExactReference {
     Near near(const Box& box) const;
 
   private:
-    // phi_ref(x) of the first n deformations of the history.
-    double valueThrough(std::size_t n, const Eigen::Vector3d& x) const;
     // phi_ref(x) through the deformations `steps` (latest first); nullopt when the point
     // leaves the box its step allows (`after`, when given).
     std::optional<double> valueAlong(const std::vector<std::size_t>& steps,
@@ -81,8 +79,9 @@ class ExactReference {
 
     StartFunction start_;
     std::vector<std::shared_ptr<const StepDeformation>> history_;
-    std::vector<double> fromValues_; // per deformation: the value a fill is made from, or 0
-    bool fills_ = false;             // whether a deformation of the history fills a region
+    std::vector<std::size_t> latestFirst_; // the history's indices, the last applied first
+    std::vector<double> fromValues_;       // per deformation: the value a fill is made from, or 0
+    bool fills_ = false;                   // whether a deformation of the history fills a region
 };
 
 } // namespace sweepers
