@@ -80,7 +80,7 @@ void ModelerHarness::afterSwap(Modeler& m, Clock::time_point frameStart,
 void ModelerHarness::finish(Modeler& m) const {
     if (opt_.latencyReport) reportLatency(m);
     if (!opt_.latencyCsv.empty()) writeLatencyCsv(opt_.latencyCsv);
-    if (!opt_.saveVdb.empty()) m.document().saveVdb(opt_.saveVdb);
+    if (!opt_.saveVdb.empty()) m.document().saveVdb(opt_.saveVdb, m.savedPrecision());
     if (!opt_.saveScript.empty()) m.document().saveScript(opt_.saveScript);
     if (!opt_.saveFrame.empty()) {
         try {

@@ -41,6 +41,7 @@ Modeler::Modeler(const ModelerOptions& o, GLFWwindow* w, ModelerHarness& harness
     std::snprintf(ui_.path, sizeof ui_.path, "%s",
                   o.open.empty() ? "untitled.vdb" : o.open.c_str());
     ui_.voxelSizeInput = float(o.voxelSize);
+    ui_.saveHalf = o.saveHalf;
     syncViewport();
     // Interrupted sessions are looked for before this one exists (its lock is held).
     std::vector<std::string> interrupted;
@@ -402,7 +403,13 @@ void Modeler::saveFrame(const std::string& path) const {
     if (isMeshPath(path))
         writeMesh(film_->mesher()->weld(), path);
     else
-        writeLevelSet(*film_->grid(), path);
+        writeLevelSet(*film_->grid(), path, savedPrecision());
+}
+
+LevelSetWriteOptions Modeler::savedPrecision() const {
+    LevelSetWriteOptions options;
+    options.half = ui_.saveHalf;
+    return options;
 }
 
 void Modeler::confirm(const std::string& question, std::function<void()> action) {
@@ -459,7 +466,7 @@ void Modeler::save(const std::string& path) {
             writeMesh(doc_->mesher().weld(), path);
             return; // an export does not save the document
         } else {
-            doc_->saveVdb(path);
+            doc_->saveVdb(path, savedPrecision());
         }
         doc_->markSaved();
         ui_.status = "saved " + path;

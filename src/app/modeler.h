@@ -36,6 +36,7 @@ struct ModelerOptions {
     bool replayLive = false; // replay at frame pace, not waiting for the sculpting
     std::string saveVdb;     // written when the window closes (for tests and batch use)
     std::string saveScript;  // the recorded stroke script, written when the window closes
+    bool saveHalf = false;   // level sets saved with 16-bit float values (the panel's box)
     // The history played as a film (the timeline): one PNG per frame written here
     // (frame_0001.png, ...), after the replay if any, then the window closes.
     std::string recordFrames;
@@ -88,6 +89,8 @@ class Modeler {
     Timeline* openFilm();
     // The film's frame as a level set (.vdb) or a mesh.
     void saveFrame(const std::string& path) const;
+    // How Save writes level sets: the panel's "half floats" box (first set by --half).
+    LevelSetWriteOptions savedPrecision() const;
 
   private:
     void syncViewport();

@@ -137,6 +137,10 @@ void documentSection(PanelState& ui, PanelRequests& out) {
     ImGui::SameLine();
     out.newSphere = ImGui::Button("New sphere");
     mustFit(ui, "New sphere");
+    ImGui::Checkbox("half floats", &ui.saveHalf);
+    if (ImGui::IsItemHovered())
+        ImGui::SetTooltip("Save .vdb files with 16-bit float values: a third smaller, each "
+                          "value within a voxel of the surface rounded by under 1/2048 voxel");
     ImGui::TextWrapped("Open reads .vdb and .json, imports .obj/.ply/.stl; Save writes "
                        ".vdb, the stroke script for .json, a mesh for .obj/.ply/.stl.");
 }

@@ -35,6 +35,7 @@ struct Figures {
 struct PanelState {
     char path[1024] = {};
     float voxelSizeInput = 1.0f / 64;
+    bool saveHalf = false;     // Save writes a .vdb's values as 16-bit floats
     std::string status, error; // a line under the panel; a dialog
     // A question (Yes runs the action), the question before quitting with unsaved changes,
     // and an interrupted session the user has not decided about (and what the offer says).

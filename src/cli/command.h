@@ -42,4 +42,9 @@ extern FlagInterrupter gStop;
 
 void printJson(const nlohmann::json& j);
 
+// What --half says wherever a command writes level sets (apply, animate, study).
+inline constexpr const char* kHalfHelp =
+    "Write the level sets' values as 16-bit floats: files a third smaller, each value "
+    "near the surface rounded by under 1/2048 voxel (docs/files.md)";
+
 } // namespace sweepers::cli

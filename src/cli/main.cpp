@@ -256,12 +256,20 @@ void exportMesh(const Grid& grid, const std::string& path, const std::string& up
     reportMeshWritten(path, mesh);
 }
 
+// --half, refused before any stroke runs when the grid's values would not survive it.
+void requireHalfFits(bool half, const Grid& grid) {
+    if (!half) return;
+    if (const std::string why = halfPrecisionProblem(grid.voxelSize()[0], halfWidthOf(grid));
+        !why.empty())
+        throw UsageError("--half: " + why);
+}
+
 struct ApplyArgs {
     std::string script, output, mesh, up = "y";
     double voxelSize = 0.0; // 0: the script's
     bool voxelSizeGiven = false;
     bool perSubStep = false, firstOrder = false, stats = false, cubic = false, trilinear = false,
-         force = false;
+         force = false, half = false;
 };
 
 int runApply(const ApplyArgs& a) {
@@ -280,6 +288,7 @@ int runApply(const ApplyArgs& a) {
     options.interrupter = &gStop;
     Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop, a.force),
                       options);
+    requireHalfFits(a.half, sculptor.grid());
     const Grid& grid = sculptor.grid();
     // The volumes are only for the closing line and the report, and each walks the whole
     // band, which on one thread is a noticeable share of a short script: skipped when
@@ -351,7 +360,9 @@ int runApply(const ApplyArgs& a) {
     }
     // Both files are written before either replaces its old version: a failed mesh write
     // leaves no new grid behind.
-    AtomicWrite vdb = prepareLevelSet(grid, a.output);
+    LevelSetWriteOptions written;
+    written.half = a.half;
+    AtomicWrite vdb = prepareLevelSet(grid, a.output, written);
     std::optional<AtomicWrite> meshFile;
     TriangleMesh mesh;
     if (!a.mesh.empty()) {
@@ -432,7 +443,7 @@ constexpr std::size_t kMostFrames = 1000000;
 struct AnimateArgs {
     std::string script, output, mesh, frames, fog, up = "y";
     double fps = 24.0, secondsPerSegment = 0.25, voxelSize = 0.0;
-    bool voxelSizeGiven = false, force = false;
+    bool voxelSizeGiven = false, force = false, half = false;
 };
 
 // "A-B" or "A", within 1..count.
@@ -503,8 +514,13 @@ int runAnimate(const AnimateArgs& a) {
     options.interrupter = &gStop;
     Sculptor sculptor(makeStartGrid(script, directoryOf(a.script), a.voxelSize, &gStop, a.force),
                       options);
+    requireHalfFits(a.half, sculptor.grid());
     const double h = sculptor.grid().voxelSize()[0];
-    const std::vector<std::string> digests = frameDigests(text, script, timing, a.fog);
+    // A frame is made of its fog's name and, when asked, its half-float values too: a film
+    // played again with another choice rewrites its frames rather than keeping them.
+    const FrameFileOptions frameFiles{a.fog, a.half};
+    const std::vector<std::string> digests =
+        frameDigests(text, script, timing, a.half ? a.fog + "\nhalf-float values" : a.fog);
     auto stampOf = [&](std::size_t n) {
         return FrameStamp{int(n), filmFrameTime(n, seconds, timing.fps), timing.fps, digests[n]};
     };
@@ -521,7 +537,8 @@ int runAnimate(const AnimateArgs& a) {
             on->script != want.script || on->voxelSize != h) {
             if (a.force) continue;
             throw std::runtime_error(path + ": not frame " + std::to_string(n) +
-                                     " of this film (another script, timing or voxel size); "
+                                     " of this film (another script, timing, voxel size, fog or "
+                                     "precision); "
                                      "--force overwrites it");
         }
         kept[n] = a.mesh.empty() || std::filesystem::exists(framePath(a.mesh, n));
@@ -534,7 +551,8 @@ int runAnimate(const AnimateArgs& a) {
         playFilm(
             sculptor, script, timing, first, last,
             [&](std::size_t n, double, const Grid& grid) {
-                AtomicWrite vdb = prepareFrame(grid, stampOf(n), a.fog, framePath(a.output, n));
+                AtomicWrite vdb =
+                    prepareFrame(grid, stampOf(n), framePath(a.output, n), frameFiles);
                 std::optional<AtomicWrite> meshFile;
                 if (!a.mesh.empty())
                     meshFile.emplace(prepareMesh(exportedMesh(grid, a.up), framePath(a.mesh, n)));
@@ -633,6 +651,7 @@ static int run(int argc, char** argv) {
     CLI::Option* applyVoxelSize =
         apply->add_option("--voxel-size", applyArgs.voxelSize, "Override the script's voxel size");
     apply->add_option("--mesh", applyArgs.mesh, "Also export the surface (.obj, .ply, .stl)");
+    apply->add_flag("--half", applyArgs.half, kHalfHelp);
     apply
         ->add_option("--up", applyArgs.up,
                      "The mesh's up axis: y (as shown) or z (Blender's "
@@ -715,6 +734,7 @@ static int run(int argc, char** argv) {
                      "Also a fog volume of this name beside the level set (default: density)")
         ->expected(0, 1)
         ->default_str("density");
+    animate->add_flag("--half", animateArgs.half, kHalfHelp);
     CLI::Option* animateVoxelSize = animate->add_option("--voxel-size", animateArgs.voxelSize,
                                                         "Override the script's voxel size");
     jsonFlag(animate, "the frames and files written");

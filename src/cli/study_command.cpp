@@ -76,16 +76,31 @@ int totalThreads(const StudyArgs& a) {
 
 // The plan of the scripts given (checked before anything is written), or the plan already
 // in the directory when none is given.
+// --keep and --half, given, replace what the plan keeps for the runs still to run.
+void applyOutputs(const StudyArgs& a, StudyPlan& plan) {
+    if (!a.keep.empty()) {
+        const std::optional<StudyOutputs> kept = parseKept(a.keep);
+        if (!kept)
+            throw UsageError("--keep: '" + a.keep + "' is not one of both, grids, meshes, none");
+        plan.outputs.grids = kept->grids;
+        plan.outputs.meshes = kept->meshes;
+    }
+    if (a.half) plan.outputs.half = true;
+}
+
 StudyPlan makePlan(const StudyArgs& a) {
     if (a.scripts.empty()) {
         if (!std::filesystem::exists(a.dir + "/plan.json"))
             throw UsageError("study: no script given, and " + a.dir +
                              " holds no study to go on with (plan.json)");
-        return readStudyPlan(a.dir);
+        StudyPlan plan = readStudyPlan(a.dir);
+        applyOutputs(a, plan);
+        return plan;
     }
     const std::vector<double> sizes = parseVoxelSizes(a.voxelSizes);
     const std::vector<StudyVariant> variants = parseVariants(a.variants);
     StudyPlan plan = planStudy(a.scripts, sizes, variants, a.dir, a.force);
+    applyOutputs(a, plan);
     std::error_code ec;
     std::filesystem::create_directories(a.dir, ec);
     if (ec)
@@ -133,10 +148,11 @@ int finishStudy(const StudyPlan& plan, const StudyResults& results, std::size_t 
     if (gOut.json) {
         json files = json::array();
         for (const PlannedRun& r : plan.runs)
-            if (runIsDone(plan, r)) {
-                files.push_back(runDirectory(plan, r) + "/grid.vdb");
-                files.push_back(runDirectory(plan, r) + "/mesh.ply");
-            }
+            if (runIsDone(plan, r))
+                for (const char* name : {"/grid.vdb", "/mesh.ply"})
+                    if (const std::string f = runDirectory(plan, r) + name;
+                        std::filesystem::exists(f))
+                        files.push_back(f);
         if (plotsError.empty())
             for (const char* f : {"convergence.gp", "convergence.png", "convergence.svg"})
                 files.push_back(plan.dir + "/" + f);
@@ -424,6 +440,11 @@ CLI::App* addStudyCommand(CLI::App& app, StudyArgs& a) {
                       variantNames() + " (default " + variantName(StudyVariant::Corrected) + ")");
     study->add_flag("--force", a.force,
                     "Build start shapes even when they seem to need more memory than is free");
+    CLI::Option* keep =
+        study->add_option("--keep", a.keep,
+                          "What each run keeps beside its result: both (default), grids, meshes or "
+                          "none");
+    CLI::Option* half = study->add_flag("--half", a.half, kHalfHelp);
     study->add_option("--jobs", a.jobs, "Runs at once here, the threads split between them")
         ->check(CLI::Range(1, 1024));
     study->add_option("--threads", *a.threads, "Worker threads (with --slurm: of each run)")
@@ -457,6 +478,10 @@ CLI::App* addStudyCommand(CLI::App& app, StudyArgs& a) {
     for (CLI::Option* one : {run, merge, slurm})
         for (CLI::Option* other : {run, merge, slurm, planOnly, list})
             if (one != other) one->excludes(other);
+    // A run and a merge do what the plan in the directory says.
+    for (CLI::Option* output : {keep, half})
+        for (CLI::Option* step : {run, merge})
+            output->excludes(step);
     return study;
 }
 

@@ -15,6 +15,10 @@ struct StudyArgs {
     std::vector<std::string> scripts;
     std::string dir, voxelSizes = "1/32,1/64,1/128,1/256", variants = "corrected";
     bool force = false;
+    // What each run keeps on disk (empty: the plan's, both for a new one) and whether its
+    // grid is written at half precision (once given, the plan keeps it).
+    std::string keep;
+    bool half = false;
     int jobs = 1;
     int* threads = nullptr; // the program's --threads (0: all cores)
     // One step of a study: plan only, list the runs without a result, run one, merge.

@@ -258,8 +258,8 @@ void Document::trimToBudget() {
     }
 }
 
-void Document::saveVdb(const std::string& path) {
-    writeLevelSet(sculptor_.grid(), path);
+void Document::saveVdb(const std::string& path, const LevelSetWriteOptions& options) {
+    writeLevelSet(sculptor_.grid(), path, options);
 }
 
 void Document::saveScript(const std::string& path) {

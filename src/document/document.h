@@ -14,6 +14,7 @@
 #include <string>
 
 #include "io/stroke_script.h"
+#include "io/vdb_file.h"
 #include "sculpt/sculptor.h"
 
 namespace sweepers {
@@ -111,7 +112,7 @@ class Document {
 
     // Modified since opened or last saved (the grid or the script).
     bool modified() const { return modified_; }
-    void saveVdb(const std::string& path);
+    void saveVdb(const std::string& path, const LevelSetWriteOptions& options = {});
     void saveScript(const std::string& path);
     void markSaved() { modified_ = false; }
     void markModified() { modified_ = true; }

@@ -141,23 +141,24 @@ std::vector<std::string> frameDigests(const std::string& scriptText, const Strok
     return digests;
 }
 
-AtomicWrite prepareFrame(const Grid& grid, const FrameStamp& stamp, const std::string& fogName,
-                         const std::string& path) {
-    openvdb::MetaMap meta;
-    meta.insertMeta("frame", openvdb::Int32Metadata(stamp.frame));
-    meta.insertMeta("time", openvdb::DoubleMetadata(stamp.time));
-    meta.insertMeta("fps", openvdb::DoubleMetadata(stamp.fps));
-    meta.insertMeta("script", openvdb::StringMetadata(stamp.script));
-    openvdb::GridCPtrVec beside;
-    if (!fogName.empty()) {
+AtomicWrite prepareFrame(const Grid& grid, const FrameStamp& stamp, const std::string& path,
+                         const FrameFileOptions& options) {
+    LevelSetWriteOptions write;
+    write.half = options.half;
+    write.meta.insertMeta("frame", openvdb::Int32Metadata(stamp.frame));
+    write.meta.insertMeta("time", openvdb::DoubleMetadata(stamp.time));
+    write.meta.insertMeta("fps", openvdb::DoubleMetadata(stamp.fps));
+    write.meta.insertMeta("script", openvdb::StringMetadata(stamp.script));
+    if (!options.fog.empty()) {
         GridPtr fog = grid.deepCopy();
         openvdb::tools::sdfToFogVolume(*fog);
-        fog->setName(fogName);
-        for (auto it = meta.beginMeta(); it != meta.endMeta(); ++it)
+        fog->setName(options.fog);
+        for (auto it = write.meta.beginMeta(); it != write.meta.endMeta(); ++it)
             fog->insertMeta(it->first, *it->second);
-        beside.push_back(fog);
+        fog->setSaveFloatAsHalf(options.half);
+        write.beside.push_back(fog);
     }
-    return prepareLevelSet(grid, path, meta, beside);
+    return prepareLevelSet(grid, path, write);
 }
 
 std::optional<FrameStamp> readFrameStamp(const std::string& path) {

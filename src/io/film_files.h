@@ -45,12 +45,18 @@ std::string scriptDigest(const std::string& text);
 std::vector<std::string> frameDigests(const std::string& scriptText, const StrokeScript& script,
                                       const FilmTiming& timing, const std::string& extra = "");
 
+// What a frame file holds besides its level set, and at what precision.
+struct FrameFileOptions {
+    // When not empty, a fog volume of that name (0 outside, rising across the inside half of
+    // the band to 1 deep inside: openvdb::tools::sdfToFogVolume).
+    std::string fog;
+    bool half = false; // the grids' values as 16-bit floats (LevelSetWriteOptions::half)
+};
+
 // Frame `stamp.frame`: the level set with the stamp as metadata (frame, time, fps, script)
-// and, when fogName is not empty, a fog volume of that name (0 outside, rising across the
-// inside half of the band to 1 deep inside: openvdb::tools::sdfToFogVolume). Written and
-// flushed, not yet in place (io/atomic_file.h).
-AtomicWrite prepareFrame(const Grid& grid, const FrameStamp& stamp, const std::string& fogName,
-                         const std::string& path);
+// and what `options` asks. Written and flushed, not yet in place (io/atomic_file.h).
+AtomicWrite prepareFrame(const Grid& grid, const FrameStamp& stamp, const std::string& path,
+                         const FrameFileOptions& options = {});
 
 // The stamp of a frame file and its voxel size (read in a child process,
 // io/isolated_read.h); nullopt when the file holds no usable level set or its level set no

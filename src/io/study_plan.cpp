@@ -208,6 +208,8 @@ void writeStudyPlan(const StudyPlan& plan) {
     const nlohmann::ordered_json out = {{"format", kPlanFormat},
                                         {"version", plan.version},
                                         {"force", plan.force},
+                                        {"keep", keptName(plan.outputs)},
+                                        {"half", plan.outputs.half},
                                         {"scripts", scripts},
                                         {"runs", runs}};
     writeTextAtomically(planPath(plan.dir), out.dump(2) + "\n");
@@ -231,6 +233,11 @@ StudyPlan readStudyPlan(const std::string& dir) {
     try {
         plan.version = j.at("version").get<std::string>();
         plan.force = j.at("force").get<bool>();
+        // (Plans written before --keep and --half kept both, at full precision.)
+        const auto kept = parseKept(j.value("keep", std::string("both")));
+        if (!kept) throw bad("'keep' is not one of both, grids, meshes, none");
+        plan.outputs = *kept;
+        plan.outputs.half = j.value("half", false);
         std::map<std::string, std::size_t> byName;
         for (const json& s : j.at("scripts")) {
             byName[s.at("name").get<std::string>()] = plan.scripts.size();
@@ -275,6 +282,20 @@ const PlannedRun& findRun(const StudyPlan& plan, const std::string& id) {
     for (const PlannedRun& r : plan.runs)
         ids += (ids.empty() ? "" : ", ") + r.id;
     throw FileError(plan.dir + ": the study has no run '" + id + "' (its runs: " + ids + ")");
+}
+
+std::optional<StudyOutputs> parseKept(const std::string& keep) {
+    StudyOutputs out;
+    if (keep == "both") return out;
+    if (keep != "grids" && keep != "meshes" && keep != "none") return std::nullopt;
+    out.grids = keep == "grids";
+    out.meshes = keep == "meshes";
+    return out;
+}
+
+std::string keptName(const StudyOutputs& outputs) {
+    if (outputs.grids) return outputs.meshes ? "both" : "grids";
+    return outputs.meshes ? "meshes" : "none";
 }
 
 std::string runDirectory(const StudyPlan& plan, const PlannedRun& run) {
@@ -323,12 +344,25 @@ StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run, Interrupt
                               ": changed since the study was planned (plan the study again)");
         const GridPtr start =
             makeStartGrid(script, directoryOf(source.path), run.voxelSize, interrupter, plan.force);
+        if (plan.outputs.half)
+            if (const std::string why = halfPrecisionProblem(run.voxelSize, halfWidthOf(*start));
+                !why.empty())
+                throw ScriptError("--half: " + why);
         done = runStudyCase(start, script.strokes, exactStart(script, start), run.variant,
                             interrupter, progress);
-        AtomicWrite vdb = prepareLevelSet(*done->grid, dir + "/grid.vdb");
-        AtomicWrite mesh = prepareMesh(done->mesh, dir + "/mesh.ply");
-        vdb.commit();
-        mesh.commit();
+        // Both files are written before either is put in place; a file the plan does not keep
+        // is removed, so a run's directory holds what its plan says, whatever ran there before.
+        const std::string gridPath = dir + "/grid.vdb", meshPath = dir + "/mesh.ply";
+        std::optional<AtomicWrite> vdb, mesh;
+        LevelSetWriteOptions precision;
+        precision.half = plan.outputs.half;
+        if (plan.outputs.grids) vdb.emplace(prepareLevelSet(*done->grid, gridPath, precision));
+        if (plan.outputs.meshes) mesh.emplace(prepareMesh(done->mesh, meshPath));
+        for (const auto& [kept, path] :
+             {std::pair{plan.outputs.grids, gridPath}, std::pair{plan.outputs.meshes, meshPath}})
+            if (!kept) std::filesystem::remove(path, ec);
+        if (vdb) vdb->commit();
+        if (mesh) mesh->commit();
         const std::string host = row.host;
         const int threads = row.threads;
         row = done->row;

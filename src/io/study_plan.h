@@ -4,7 +4,8 @@
 // (docs/studies.md). The plan (DIR/plan.json) names every run, what its result depends on
 // (a digest of the program's version, its script and the files the script reads, its voxel
 // size and variant) and an estimate of its memory and time. A run's result
-// (DIR/runs/ID/result.json, beside its grid.vdb and mesh.ply) is written last and
+// (DIR/runs/ID/result.json, beside its grid.vdb and mesh.ply unless the plan keeps only one
+// or neither) is written last and
 // atomically, so a result on disk is a finished run, and a result whose digest matches the
 // plan is not run again. Merging the results gives the study's table, report and plots.
 #pragma once
@@ -38,12 +39,23 @@ struct PlannedRun {
     std::string basis;
 };
 
+// What a run keeps on disk beside its result: its grid and its mesh (study --keep), the grid
+// at full or half precision (--half). Its row is the same whatever it keeps.
+struct StudyOutputs {
+    bool grids = true, meshes = true;
+    bool half = false;
+};
+// "both", "grids", "meshes" or "none", as --keep says it; nullopt for anything else.
+std::optional<StudyOutputs> parseKept(const std::string& keep);
+std::string keptName(const StudyOutputs& outputs);
+
 struct StudyPlan {
     std::string dir; // absolute
     std::string version;
     std::vector<StudyScript> scripts;
     std::vector<PlannedRun> runs; // script by script, coarsest voxel size first
     bool force = false;           // build starts even when they seem not to fit in memory
+    StudyOutputs outputs;
 };
 
 // Plans a study of `scripts` at `voxelSizes` (coarsest first) and `variants` in `dir`
@@ -68,7 +80,8 @@ std::optional<StudyRow> readRunResult(const StudyPlan& plan, const PlannedRun& r
 // Whether the run has a result without a failure.
 bool runIsDone(const StudyPlan& plan, const PlannedRun& run);
 
-// Runs one run with the process's worker threads and writes its grid, mesh and result.
+// Runs one run with the process's worker threads and writes its result, and its grid and
+// mesh as the plan's outputs say.
 // A run that fails writes a result that says why, and is returned with that failure.
 // Throws Cancelled, writing nothing, when `interrupter` stops it.
 StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run,

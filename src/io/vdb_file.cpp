@@ -8,6 +8,8 @@
 
 #include <openvdb/io/File.h>
 #include <openvdb/io/Stream.h>
+#include <openvdb/math/Half.h>
+#include <openvdb/tools/ChangeBackground.h>
 
 #include "core/format.h"
 #include "core/limits.h"
@@ -148,33 +150,71 @@ class FileWriter : public openvdb::io::Archive {
 
 namespace {
 
+// The smallest 16-bit float at least `value` (a positive float under 65504), as a float.
+float halfAtLeast(float value) {
+    openvdb::math::half h(value);
+    if (float(h) < value) h.setBits(static_cast<unsigned short>(h.bits() + 1));
+    return float(h);
+}
+
 // The grids of a level-set file: the level set with its metadata, then `beside`.
-openvdb::GridCPtrVec levelSetFileGrids(const Grid& grid, const openvdb::MetaMap& meta,
-                                       const openvdb::GridCPtrVec& beside) {
+openvdb::GridCPtrVec levelSetFileGrids(const Grid& source, const LevelSetWriteOptions& options) {
     initVdb();
+    // At half precision the background (every inactive value) would round to the nearest
+    // 16-bit float, below the band's half-width when the voxel size is not a power of two,
+    // and OpenVDB's checks and tools would read a narrower band than the file's metadata
+    // says: it is raised to the next 16-bit float up, on a copy of the grid.
+    GridPtr raised;
+    if (options.half)
+        if (const float up = halfAtLeast(source.background()); up != source.background()) {
+            raised = source.deepCopy();
+            openvdb::tools::changeLevelSetBackground(raised->tree(), up);
+        }
+    const Grid& grid = raised ? *raised : source;
     // The file's metadata is put together on a grid without voxels and written with the
     // grid's own tree (shared, only read): a deep copy of the voxels, to add a few names,
     // held the grid's memory twice while the file was written.
     GridPtr named = grid.copyWithNewTree();
     markAsDocument(*named);
     named->insertMeta("voxel_size", openvdb::FloatMetadata(float(grid.voxelSize()[0])));
-    for (auto it = meta.beginMeta(); it != meta.endMeta(); ++it)
+    for (auto it = options.meta.beginMeta(); it != options.meta.endMeta(); ++it)
         named->insertMeta(it->first, *it->second);
+    // Always said: a grid read from a half-float file carries the flag in its metadata, and
+    // would otherwise be written at half precision again unasked.
+    named->setSaveFloatAsHalf(options.half);
     openvdb::GridCPtrVec grids{grid.copyReplacingMetadata(*named)};
-    grids.insert(grids.end(), beside.begin(), beside.end());
+    grids.insert(grids.end(), options.beside.begin(), options.beside.end());
     return grids;
 }
 
 } // namespace
 
-AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path, const openvdb::MetaMap& meta,
-                            const openvdb::GridCPtrVec& beside) {
-    return prepareGrids(levelSetFileGrids(grid, meta, beside), path);
+std::string halfPrecisionProblem(double voxelSize, double halfWidth) {
+    // The largest 16-bit float is 65504 and the smallest with full relative precision 2^-14:
+    // a value under a voxel from the surface is only rounded relatively while a voxel is
+    // larger than that.
+    constexpr double kLargestHalf = 65504.0, kSmallestNormalHalf = 1.0 / 16384;
+    if (voxelSize * halfWidth > kLargestHalf)
+        return "16-bit floats end at 65504, within the band of " + formatNumber(halfWidth) +
+               " voxels of size " + formatNumber(voxelSize) + "; write at full precision";
+    if (voxelSize < kSmallestNormalHalf)
+        return "16-bit floats round a voxel size under 6.1e-05 (" + formatNumber(voxelSize) +
+               ") too coarsely; write at full precision";
+    return "";
+}
+
+AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path,
+                            const LevelSetWriteOptions& options) {
+    if (options.half)
+        if (const std::string why = halfPrecisionProblem(grid.voxelSize()[0], halfWidthOf(grid));
+            !why.empty())
+            throw FileError(path + ": " + why);
+    return prepareGrids(levelSetFileGrids(grid, options), path);
 }
 
 std::string levelSetStream(const Grid& grid) {
     std::ostringstream out(std::ios::binary);
-    openvdb::io::Stream(out).write(levelSetFileGrids(grid, {}, {}));
+    openvdb::io::Stream(out).write(levelSetFileGrids(grid, {}));
     return out.str();
 }
 
@@ -183,8 +223,8 @@ AtomicWrite prepareGrids(const openvdb::GridCPtrVec& grids, const std::string& p
     return AtomicWrite(path, [&](std::ostream& out) { FileWriter().writeTo(out, grids); });
 }
 
-void writeLevelSet(const Grid& grid, const std::string& path) {
-    prepareLevelSet(grid, path).commit();
+void writeLevelSet(const Grid& grid, const std::string& path, const LevelSetWriteOptions& options) {
+    prepareLevelSet(grid, path, options).commit();
 }
 
 } // namespace sweepers

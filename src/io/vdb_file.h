@@ -38,13 +38,27 @@ openvdb::GridPtrVecPtr readAllGrids(const std::string& path);
 std::string describeGrid(const openvdb::GridBase& grid);
 // " (it holds 'a' (float, level set), ...)" for the grids so described.
 std::string holdsClause(const std::vector<std::string>& grids);
+// How a level set is written: what joins it in the file, and at what precision.
+struct LevelSetWriteOptions {
+    openvdb::MetaMap meta;       // joins the level set's metadata
+    openvdb::GridCPtrVec beside; // grids that follow it in the file
+    // Values stored as 16-bit floats (OpenVDB's save-float-as-half flag on the ordinary float
+    // grid, which every reader turns back into 32-bit floats): files a third smaller, each
+    // value rounded by at most 1/2048 of itself or of a voxel, whichever is larger
+    // (docs/files.md). Off: the exact values, which a history's guarantees (docs/engine.md)
+    // are about.
+    bool half = false;
+};
+// Why a level set at this voxel size and half-width cannot be written with 16-bit floats, in
+// the user's words, or "" when it can: its band reaches past the largest 16-bit float, or its
+// voxels are so small that values near the surface lose the relative precision above.
+std::string halfPrecisionProblem(double voxelSize, double halfWidth);
 // Atomic (io/atomic_file.h): a failed write, a full disk included, keeps the old file.
-void writeLevelSet(const Grid& grid, const std::string& path);
-// The same, written and flushed but not yet in place: commit() puts it there. `meta` joins
-// the level set's metadata, and the grids `beside` follow it in the file.
+void writeLevelSet(const Grid& grid, const std::string& path,
+                   const LevelSetWriteOptions& options = {});
+// The same, written and flushed but not yet in place: commit() puts it there.
 AtomicWrite prepareLevelSet(const Grid& grid, const std::string& path,
-                            const openvdb::MetaMap& meta = {},
-                            const openvdb::GridCPtrVec& beside = {});
+                            const LevelSetWriteOptions& options = {});
 // The level set as prepareLevelSet writes it, as the bytes of an in-memory VDB stream
 // (openvdb::io::Stream), which pyopenvdb's grids unpickle.
 std::string levelSetStream(const Grid& grid);

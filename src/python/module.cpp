@@ -355,10 +355,23 @@ template <typename Class, typename With> void addShapeMethods(Class& cls, const 
                 return arrayOf(with(s, [&](const Shape& x) { return x.exactDistance(p); }));
             },
             py::arg("points"),
-            "The exact shape's implicit function at an n x 3 array of points: the start "
-            "pulled back through the inverse of every deformation applied, the reference "
-            "`study` measures against (a distance for a sphere start near the surface; "
-            "negative inside).")
+            "The signed distance to the exact shape, to first order, at an n x 3 array of "
+            "points: exact_value over the length of its gradient. Zero on the exact surface "
+            "and negative inside; exact where the history carries the start rigidly and the "
+            "start is a distance (a sphere); near the surface elsewhere, off by the square of "
+            "the distance. Away from the surface it is not the distance to the shape: where "
+            "no tool reached, it is the distance to the start's surface (docs/python.md).")
+        .def(
+            "exact_value",
+            [with](const Self& s, const Points& points) {
+                const std::vector<Eigen::Vector3d> p = pointsOf(points);
+                return arrayOf(with(s, [&](const Shape& x) { return x.exactValue(p); }));
+            },
+            py::arg("points"),
+            "The exact shape's implicit function at an n x 3 array of points: the start's "
+            "value at the point the inverse of every deformation applied takes them to, the "
+            "reference `study` measures against; negative inside, zero on the exact surface, "
+            "stretched or squeezed where the tools stretched or squeezed space.")
         .def(
             "to_vdb_bytes",
             [with](const Self& s) {
@@ -374,15 +387,17 @@ template <typename Class, typename With> void addShapeMethods(Class& cls, const 
             "The level set as a pyopenvdb.FloatGrid (needs pyopenvdb).")
         .def(
             "save",
-            [with](const Self& s, const py::object& path) {
+            [with](const Self& s, const py::object& path, bool half) {
                 const std::string p = pathOf(path);
                 with(s, [&](const Shape& x) {
-                    x.save(p);
+                    x.save(p, half);
                     return 0;
                 });
             },
-            py::arg("path"),
-            "Writes the level set (.vdb) or its surface (.obj, .ply, .stl), atomically.");
+            py::arg("path"), py::arg("half") = false,
+            "Writes the level set (.vdb) or its surface (.obj, .ply, .stl), atomically; "
+            "half=True stores the .vdb's values as 16-bit floats (a third smaller, each value "
+            "within a voxel of the surface rounded by under 1/2048 voxel).");
 }
 
 // A Sculptor's start: None (a unit sphere), a dict as a script's "start", or a path to a
@@ -443,7 +458,11 @@ double voxelSizeOf(const py::handle& value) {
 
 py::object study(const py::object& scripts, const py::object& voxelSizes,
                  const py::object& variants, const py::object& directory, bool force,
-                 const py::object& progress) {
+                 const py::object& progress, const std::string& keep, bool half) {
+    std::optional<StudyOutputs> outputs = parseKept(keep);
+    if (!outputs)
+        throw std::invalid_argument("keep: '" + keep + "' is not one of both, grids, meshes, none");
+    outputs->half = half;
     std::vector<std::string> paths;
     if (py::isinstance<py::str>(scripts) || isPath(scripts))
         paths.push_back(pathOf(scripts));
@@ -477,6 +496,7 @@ py::object study(const py::object& scripts, const py::object& voxelSizes,
         dir = pathOf(directory);
     }
     StudyPlan plan = planStudy(paths, sizes, kinds, dir, force);
+    plan.outputs = *outputs;
     std::filesystem::create_directories(plan.dir);
     const std::string json =
         runEngine(progress, "study", [&](Interrupter* stop, const Progress& report) {
@@ -687,9 +707,11 @@ PYBIND11_MODULE(sweepers, m) {
         variantNames() +
         ") and returns its rows, keyed by the columns of study.csv: a pandas DataFrame when "
         "pandas is installed, else a list of dicts. In `directory` (kept, and resumed from) or "
-        "a temporary one. `progress` sees runs done and in all.";
+        "a temporary one. `progress` sees runs done and in all. `keep`: what each run keeps beside "
+        "its result (both, grids, meshes or none); `half`: its grid as 16-bit floats.";
     m.def("study", &study, py::arg("scripts"), py::arg("voxel_sizes"),
           py::arg("variants") = py::make_tuple(variantName(StudyVariant::Corrected)),
           py::arg("directory") = py::none(), py::arg("force") = false,
-          py::arg("progress") = py::none(), studyDoc.c_str());
+          py::arg("progress") = py::none(), py::arg("keep") = "both", py::arg("half") = false,
+          studyDoc.c_str());
 }

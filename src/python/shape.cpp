@@ -50,27 +50,60 @@ std::vector<double> Shape::sample(const std::vector<Eigen::Vector3d>& points) co
     });
 }
 
-std::vector<double> Shape::exactDistance(const std::vector<Eigen::Vector3d>& points) const {
+ExactReference Shape::reference() const {
     ExactReference reference(start_);
     for (const auto& d : history_) {
         // A smooth dab deforms nothing: its velocity was the surface's own curvature.
         if (!d) throw std::invalid_argument("the history smooths: no exact shape stands behind it");
         reference.append(d);
     }
+    return reference;
+}
+
+std::vector<double> Shape::exactValue(const std::vector<Eigen::Vector3d>& points) const {
+    const ExactReference exact = reference();
     return forEachPoint(points.size(),
-                        [&] { return [&](std::size_t i) { return reference.value(points[i]); }; });
+                        [&] { return [&](std::size_t i) { return exact.value(points[i]); }; });
+}
+
+std::vector<double> Shape::exactDistance(const std::vector<Eigen::Vector3d>& points) const {
+    const ExactReference exact = reference();
+    return forEachPoint(points.size(), [&] {
+        return [&](std::size_t i) {
+            const Eigen::Vector3d& x = points[i];
+            const double value = exact.value(x);
+            // The gradient by central differences, a step small against any tool or voxel and
+            // large against the rounding of x's coordinates.
+            const double step = 1e-6 * std::max(1.0, x.cwiseAbs().maxCoeff());
+            Eigen::Vector3d gradient;
+            for (int a = 0; a < 3; ++a) {
+                Eigen::Vector3d e = Eigen::Vector3d::Zero();
+                e[a] = step;
+                gradient[a] = (exact.value(x + e) - exact.value(x - e)) / (2.0 * step);
+            }
+            // Where the gradient vanishes (a medial point, such as a sphere's centre) there is
+            // no direction to the surface: the value itself.
+            const double norm = gradient.norm();
+            return norm > 1e-9 ? value / norm : value;
+        };
+    });
 }
 
 std::string Shape::vdbBytes() const {
     return levelSetStream(*grid_);
 }
 
-void Shape::save(const std::string& path) const {
+void Shape::save(const std::string& path, bool half) const {
     if (isMeshPath(path)) {
+        if (half)
+            throw std::invalid_argument("half: only a .vdb is written at half precision, not " +
+                                        path);
         writeMesh(mesh(), path);
         return;
     }
-    writeLevelSet(*grid_, path);
+    LevelSetWriteOptions options;
+    options.half = half;
+    writeLevelSet(*grid_, path, options);
 }
 
 Shape applyScript(const StrokeScript& script, const std::string& baseDir, double voxelSize,

@@ -30,13 +30,18 @@ class Shape {
     TriangleMesh mesh() const;
     // The grid's signed distance at each point (trilinear), and the exact reference's.
     std::vector<double> sample(const std::vector<Eigen::Vector3d>& points) const;
+    // The exact reference's implicit function (what `study` measures against), and the
+    // first-order signed distance to its zero set: the value over its gradient's length.
+    std::vector<double> exactValue(const std::vector<Eigen::Vector3d>& points) const;
     std::vector<double> exactDistance(const std::vector<Eigen::Vector3d>& points) const;
     // The level set as `apply` writes it, as the bytes of an in-memory VDB stream.
     std::string vdbBytes() const;
-    // A .vdb, or a mesh (.obj, .ply, .stl), written atomically.
-    void save(const std::string& path) const;
+    // A .vdb (its values as 16-bit floats when `half`), or a mesh (.obj, .ply, .stl),
+    // written atomically.
+    void save(const std::string& path, bool half = false) const;
 
   private:
+    ExactReference reference() const; // throws std::invalid_argument when the history smooths
     std::shared_ptr<const Grid> grid_;
     ExactReference::StartFunction start_;
     History history_;

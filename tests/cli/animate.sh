@@ -118,7 +118,7 @@ sed 's/{ "time": 0.5, "t": \[1.3, 0.3, 0\] }/{ "time": 0.5, "t": [1.3, 0.45, 0] 
 cp -a "$tmp/g" "$tmp/g_before"
 grab_stamps() { for n in $(seq 9); do stat -c "$n %Y.%y" "$tmp/g/grab_$n.vdb"; done; }
 before=$(grab_stamps)
-refuses "sweepers-cli: $tmp/g/grab_2.vdb: not frame 2 of this film (another script, timing or voxel size); --force overwrites it" \
+refuses "sweepers-cli: $tmp/g/grab_2.vdb: not frame 2 of this film (another script, timing, voxel size, fog or precision); --force overwrites it" \
   animate "$tmp/edited_grab.json" -o "$tmp/g/grab_#.vdb" --fps 4 --voxel-size $h
 "$cli" animate "$tmp/edited_grab.json" -o "$tmp/g/grab_#.vdb" --fps 4 --voxel-size $h \
   --force 2>"$tmp/err"
@@ -146,6 +146,28 @@ grep -q "wrote frames 1-13 of 13 (2 s at 6 fps) to $tmp/f/horn_####.vdb, 12 kept
 "$py" "$here/../app/same_grid.py" "$tmp/f/horn_0004.vdb" "$tmp/frame4.vdb"
 echo "resumed: 12 frames kept, frame 4 made again"
 
+# --- --half: frames with 16-bit float values, within their bound of the exact frames; a
+# film at the other precision is another film ----------------------------------------------
+"$cli" animate "$film" -o "$tmp/hf/horn_####.vdb" --fps 6 --frames 1-3 --voxel-size $h --fog \
+  --half -q
+"$py" - "$tmp/hf/horn_0003.vdb" "$tmp/f/horn_0003.vdb" <<'PY'
+import sys, pyopenvdb as vdb
+half, meta = vdb.readAll(sys.argv[1])
+full = vdb.read(sys.argv[2], "surface")
+assert all(g.metadata["is_saved_as_half_float"] is True for g in half), [g.metadata for g in half]
+surface = next(g for g in half if g.name == "surface")
+assert surface.gridClass == vdb.GridClass.LEVEL_SET and surface["frame"] == 3
+h = full.transform.voxelSize()[0]
+a = {it.min: it.value for it in full.citerOnValues() if it.count == 1}
+b = {it.min: it.value for it in surface.citerOnValues() if it.count == 1}
+assert a.keys() == b.keys()
+worst = max(abs(b[k] - v) / max(abs(v), h) for k, v in a.items())
+assert 0 < worst <= 1 / 2048, worst
+PY
+refuses "sweepers-cli: $tmp/hf/horn_0001.vdb: not frame 1 of this film (another script, timing, voxel size, fog or precision); --force overwrites it" \
+  animate "$film" -o "$tmp/hf/horn_####.vdb" --fps 6 --frames 1-3 --voxel-size $h --fog
+echo "--half: frames 1-3 at 16-bit floats, within 1/2048; at full precision another film"
+
 # --- Ctrl-C: the frames written are whole and kept ---------------------------------------
 stopped INT "$tmp/err" '[ "$(ls "$tmp/c" 2>/dev/null | grep -c "vdb$")" -ge 3 ]' \
   animate "$film" -o "$tmp/c/horn_####.vdb" --fps 6 --voxel-size $h -q
@@ -157,11 +179,11 @@ for f in "$tmp/c"/*.vdb; do "$cli" info "$f" >/dev/null || fail "$f is not whole
 echo "stopped by SIGINT: exit 130, $(ls "$tmp/c" | wc -l) whole frames kept"
 
 # --- refusals: one line, nothing written -------------------------------------------------
-refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing or voxel size); --force overwrites it" \
+refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing, voxel size, fog or precision); --force overwrites it" \
   animate "$data/horn.json" -o "$tmp/f/horn_####.vdb" --fps 6 --voxel-size $h
-refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing or voxel size); --force overwrites it" \
+refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing, voxel size, fog or precision); --force overwrites it" \
   animate "$film" -o "$tmp/f/horn_####.vdb" --fps 24 --voxel-size $h
-refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing or voxel size); --force overwrites it" \
+refuses "sweepers-cli: $tmp/f/horn_0001.vdb: not frame 1 of this film (another script, timing, voxel size, fog or precision); --force overwrites it" \
   animate "$film" -o "$tmp/f/horn_####.vdb" --fps 6 --voxel-size 0.0625
 refuses "sweepers-cli: $tmp/bad/horn.vdb: a frame pattern needs a run of '#' for the frame number (for example frames/shape_####.vdb)" \
   animate "$film" -o "$tmp/bad/horn.vdb"

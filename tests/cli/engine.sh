@@ -106,6 +106,48 @@ PY
 "$cli" mesh "$tmp/horn.vdb" -o "$tmp/horn.obj" 2>/dev/null
 grep -q "^f " "$tmp/horn.obj" || fail "mesh wrote no faces"
 
+# --- --half: a float level set to every reader, values rounded within the bound ---------
+# (At 0.03 the band's half-width, 0.09, is no 16-bit float: the background is the next one
+# up, so OpenVDB's checkLevelSet still reads a band of 3 voxels.)
+"$cli" apply "$data/horn.json" -o "$tmp/horn-full.vdb" --voxel-size 0.03 -q
+"$cli" info --json "$tmp/horn-full.vdb" >"$tmp/info.json"
+"$cli" apply "$data/horn.json" -o "$tmp/horn-half.vdb" --voxel-size 0.03 --half -q
+vdb_print -l "$tmp/horn-half.vdb" >"$tmp/print" || fail "vdb_print could not read the --half file"
+grep -q "Type: Tree_float_5_4_3" "$tmp/print" || fail "vdb_print: --half not a float tree: $(cat "$tmp/print")"
+grep -q "class: level set" "$tmp/print" || fail "vdb_print: --half not a level set"
+"$cli" info --json "$tmp/horn-half.vdb" >"$tmp/info-half.json"
+"$py" - "$tmp/horn-full.vdb" "$tmp/horn-half.vdb" "$tmp/info.json" "$tmp/info-half.json" <<'PY'
+import json, os, sys, pyopenvdb as vdb
+full, half = (vdb.read(f, "surface") for f in sys.argv[1:3])
+assert half.metadata["is_saved_as_half_float"] is True, half.metadata
+assert not full.metadata.get("is_saved_as_half_float", False), full.metadata
+assert half.gridClass == vdb.GridClass.LEVEL_SET and half.valueTypeName == "float"
+h = full.transform.voxelSize()[0]
+a = {it.min: it.value for it in full.citerOnValues() if it.count == 1}
+b = {it.min: it.value for it in half.citerOnValues() if it.count == 1}
+assert a.keys() == b.keys()
+worst = max(abs(b[k] - v) / max(abs(v), h) for k, v in a.items())
+assert 0 < worst <= 1 / 2048, worst
+i, j = (json.load(open(f)) for f in sys.argv[3:5])
+for key in ("volume", "area"):
+    assert abs(j[key] - i[key]) <= 1e-4 * abs(i[key]), (key, i[key], j[key])
+assert i["openvdb_check"] == "" and j["openvdb_check"] == "", (i, j)
+assert 0.09 < half.background < 0.09 * (1 + 1 / 1024), half.background
+ratio = os.path.getsize(sys.argv[2]) / os.path.getsize(sys.argv[1])
+assert ratio < 0.75, ratio
+print(f"--half: {ratio:.3f} of the bytes, largest rounding {worst * 2048:.2f}/2048, "
+      f"volume {i['volume']:.7f} -> {j['volume']:.7f}")
+PY
+# Voxels so small that 16-bit floats lose their relative precision near the surface: refused
+# before any work, nothing written.
+cat >"$tmp/speck.json" <<'EOF'
+{ "sweepers": 1, "grid": { "voxel_size": 0.00005 },
+  "start": { "sphere": { "center": [0, 0, 0], "radius": 0.001 } }, "strokes": [] }
+EOF
+refuses "sweepers-cli: --half: 16-bit floats round a voxel size under 6.1e-05 (5e-05) too coarsely; write at full precision" \
+  apply "$tmp/speck.json" -o "$tmp/speck.vdb" --half
+[ ! -e "$tmp/speck.vdb" ] || fail "a refused --half left a file"
+
 # --- exported meshes pass the checks of mesh repair tools ------------------------------
 # No two vertices at one point, no facet without area or with a repeated corner, every
 # edge in exactly two facets that run it opposite ways. (data/mirrored_ears.json once

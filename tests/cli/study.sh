@@ -166,6 +166,31 @@ while read -r id; do "$cli" study -o "$tmp/loop" --run "$id" -q; done <"$tmp/ids
 [ -z "$("$cli" study -o "$tmp/loop" --list)" ] || fail "runs left after running them all"
 "$cli" study -o "$tmp/loop" --merge -q
 "$py" "$(dirname "$0")/same_table.py" "$tmp/jobs1/study.csv" "$tmp/loop/study.csv"
+# --- what runs keep: --keep and --half go into the plan, which --run follows; no row changes
+"$cli" study "${two[@]}" -o "$tmp/kept" "${sizes[@]}" --plan-only --keep grids --half -q
+while read -r id; do "$cli" study -o "$tmp/kept" --run "$id" -q; done <"$tmp/ids"
+"$cli" study -o "$tmp/kept" --merge -q
+"$py" "$(dirname "$0")/same_table.py" "$tmp/jobs1/study.csv" "$tmp/kept/study.csv"
+"$cli" study "${two[@]}" -o "$tmp/bare" "${sizes[@]}" --keep none --json -q >"$tmp/bare.json"
+"$py" "$(dirname "$0")/same_table.py" "$tmp/jobs1/study.csv" "$tmp/bare/study.csv"
+"$py" - "$tmp" "$tmp/ids" <<'PY'
+import json, os, sys, pyopenvdb as vdb
+t, ids = sys.argv[1], open(sys.argv[2]).read().split()
+assert json.load(open(f"{t}/kept/plan.json"))["keep"] == "grids"
+assert json.load(open(f"{t}/kept/plan.json"))["half"] is True
+for run in ids:
+    kept, bare, both = (f"{t}/{d}/runs/{run}" for d in ("kept", "bare", "jobs1"))
+    assert not os.path.exists(f"{kept}/mesh.ply"), run
+    assert vdb.read(f"{kept}/grid.vdb", "surface").metadata["is_saved_as_half_float"] is True
+    assert not vdb.read(f"{both}/grid.vdb", "surface").metadata.get("is_saved_as_half_float")
+    assert sorted(os.listdir(bare)) == ["result.json"], os.listdir(bare)
+files = json.load(open(f"{t}/bare.json"))["files"]
+assert not [f for f in files if "/runs/" in f], files
+print(f"--keep grids --half: {len(ids)} half-float grids and no meshes; --keep none: results "
+      "only; the same table")
+PY
+refuses "sweepers-cli: --keep: 'some' is not one of both, grids, meshes, none" \
+  study -o "$tmp/kept" --keep some
 refuses "sweepers-cli: $tmp/loop: the study has no run 'nope' (its runs: $(paste -sd, "$tmp/ids" | sed 's/,/, /g'))" \
   study -o "$tmp/loop" --run nope
 refuses "sweepers-cli: $tmp/none: no study plan there (plan.json); plan one with sweepers-cli study SCRIPT... -o $tmp/none" \

@@ -92,6 +92,30 @@ def test_save_writes_what_pyopenvdb_and_the_cli_read(twisted, tmp_path):
     assert info["volume"] == pytest.approx(shape.volume, rel=1e-12)
 
 
+def test_save_at_half_precision_rounds_by_its_bound_and_reads_as_a_float_level_set(
+        twisted, tmp_path):
+    shape, _, d = twisted
+    shape.save(tmp_path / "half.vdb", half=True)
+    half = vdb.read(str(tmp_path / "half.vdb"), "surface")
+    full = vdb.read(str(d / "t.vdb"), "surface")
+    assert half.metadata["is_saved_as_half_float"] is True
+    assert full.metadata.get("is_saved_as_half_float", False) is False
+    assert half.gridClass == vdb.GridClass.LEVEL_SET and half.valueTypeName == "float"
+    h = shape.voxel_size
+    a, b = voxels(full), voxels(half)
+    assert a.keys() == b.keys()
+    # Each value rounded by at most 1/2048 of itself, or of a voxel near the surface.
+    worst = max(abs(b[k] - v) / max(abs(v), h) for k, v in a.items())
+    assert 0 < worst <= 1 / 2048, worst
+    assert os.path.getsize(tmp_path / "half.vdb") < 0.75 * os.path.getsize(d / "t.vdb")
+    info = json.loads(cli("info", str(tmp_path / "half.vdb"), "--json").stdout)
+    assert info["volume"] == pytest.approx(shape.volume, rel=1e-4)
+    assert info["area"] == pytest.approx(shape.area, rel=1e-4)
+    with pytest.raises(ValueError, match="only a .vdb is written at half precision"):
+        shape.save(tmp_path / "half.ply", half=True)
+    assert not (tmp_path / "half.ply").exists()
+
+
 def test_a_script_as_a_dict_or_a_json_string_is_the_file(twisted):
     shape = twisted[0]
     text = open(RIGID).read()
@@ -346,6 +370,50 @@ def test_exact_distance_is_the_moved_sphere():
     assert np.sqrt(np.mean((shape.sample(points) - exact) ** 2)) < 0.1 / 32
 
 
+def test_exact_distance_is_a_distance_near_the_surface_and_the_starts_far_away():
+    # A unit sphere whose top a ball tool (size 0.5, falloff 0.5) pulls up by 0.3: inside the
+    # ball the map is a translation, in its falloff it stretches space, beyond it is the
+    # identity.
+    s = sweepers.Sculptor(voxel_size=1 / 16)
+    s.apply({"type": "sweep", "tools": [{"shape": "ball", "size": 0.5, "falloff": 0.5,
+             "path": [{"t": [0, 1, 0]}, {"t": [0, 1.3, 0]}]}]})
+    shape = s.shape()
+    value = lambda x: shape.exact_value(np.array([x]))[0]
+    distance = lambda x: shape.exact_distance(np.array([x]))[0]
+
+    def on_surface(angle):  # where exact_value changes sign, along a ray in the xy plane
+        d = np.array([np.sin(np.radians(angle)), np.cos(np.radians(angle)), 0.0])
+        lo, hi = 0.2, 3.0
+        for _ in range(60):
+            lo, hi = ((lo + hi) / 2, hi) if value(d * (lo + hi) / 2) < 0 else (lo, (lo + hi) / 2)
+        p = d * lo
+        g = np.array([value(p + 1e-6 * e) - value(p - 1e-6 * e) for e in np.eye(3)])
+        return p, g / np.linalg.norm(g)
+
+    # Within the ball the history is rigid: a point delta off the surface along its normal
+    # is at distance delta, and both functions say so.
+    p, n = on_surface(20)
+    for delta in (0.04, -0.02):
+        assert abs(distance(p + delta * n) - delta) < 1e-8
+        assert abs(value(p + delta * n) - delta) < 1e-8
+    # In the falloff the value is stretched (off by about a third of delta); the distance
+    # is off by the square of delta: halving delta divides its error by four or more.
+    for angle in (30, 40):
+        p, n = on_surface(angle)
+        errors = []
+        for delta in (0.02, 0.01):
+            x = p + delta * n
+            errors.append(abs(distance(x) - delta))
+            assert abs(value(x) - delta) > 0.2 * delta, (angle, delta, value(x))
+            assert abs(distance(x) - delta) < 0.05 * delta, (angle, delta, distance(x))
+        assert errors[0] / errors[1] > 3, (angle, errors)
+    # Far from the surface neither is the shape's distance: above the pulled top (at 1.3),
+    # where no tool reached, both are the distance to the start's surface.
+    vertices, _ = shape.mesh()
+    assert abs(vertices[:, 1].max() - 1.3) < 0.01
+    assert abs(distance([0, 2.6, 0]) - 1.6) < 1e-9 and abs(value([0, 2.6, 0]) - 1.6) < 1e-12
+
+
 def test_sample_is_the_grid_pyopenvdb_reads(twisted):
     shape = twisted[0]
     grid = shape.to_pyopenvdb()
@@ -394,6 +462,15 @@ def test_a_study_gives_the_clis_table(tmp_path):
     # Without a directory: a temporary one, removed.
     again = sweepers.study(RIGID, [1 / 16], "trilinear")
     assert list(again["err_rms"]) == [rows["err_rms"][0]]
+    # What its runs keep changes no row.
+    kept = sweepers.study(RIGID, [1 / 16], "trilinear", directory=tmp_path / "kept",
+                          keep="grids", half=True)
+    assert list(kept["err_rms"]) == [rows["err_rms"][0]]
+    run = tmp_path / "kept" / "runs" / "rigid_motion-trilinear_16"
+    assert not (run / "mesh.ply").exists()
+    assert vdb.read(str(run / "grid.vdb"), "surface").metadata["is_saved_as_half_float"]
+    with pytest.raises(ValueError, match="keep: 'some' is not one of both, grids, meshes, none"):
+        sweepers.study(RIGID, [1 / 16], "trilinear", keep="some")
 
 
 def test_bad_input_raises_with_the_clis_message(tmp_path):

@@ -99,6 +99,55 @@ TEST(VdbFile, ReadsTheFirstLevelSetAndRefusesOtherGrids) {
               std::string::npos);
 }
 
+TEST(VdbFile, HalfPrecisionRoundsWithinItsBoundAndIsNotPassedOn) {
+    ScratchDir dir;
+    const double h = 1.0 / 50;
+    GridPtr g = makeSphere({0.1, 0.2, 0.3}, 0.5, h, 3);
+    LevelSetWriteOptions half;
+    half.half = true;
+    writeLevelSet(*g, dir / "half.vdb", half);
+    writeLevelSet(*g, dir / "full.vdb");
+    EXPECT_LT(fs::file_size(dir / "half.vdb"), fs::file_size(dir / "full.vdb"));
+    GridPtr back = readLevelSet(dir / "half.vdb");
+    EXPECT_TRUE(back->saveFloatAsHalf());
+    // 3 x 1/50 is no 16-bit float: the background is the next one up, never narrower than the
+    // band, and every inactive value is it, as OpenVDB's checks want.
+    EXPECT_GT(back->background(), g->background());
+    EXPECT_LT(back->background(), g->background() * (1 + 1.0 / 1024));
+    std::size_t offBackground = 0;
+    for (auto it = back->cbeginValueOff(); it; ++it)
+        offBackground += std::abs(*it) != back->background();
+    EXPECT_EQ(offBackground, 0u);
+    EXPECT_TRUE(back->tree().hasSameTopology(g->tree()));
+    // Each value within 1/2048 of itself, or of a voxel near the surface; rounded somewhere.
+    double worst = 0.0;
+    auto acc = g->getConstAccessor();
+    for (auto it = back->cbeginValueOn(); it; ++it) {
+        const double exact = acc.getValue(it.getCoord());
+        worst = std::max(worst, std::abs(*it - exact) / std::max(std::abs(exact), h));
+    }
+    EXPECT_GT(worst, 0.0);
+    EXPECT_LE(worst, 1.0 / 2048);
+    // A grid read from a half file carries the flag; written without asking, it is exact.
+    writeLevelSet(*back, dir / "again.vdb");
+    GridPtr again = readLevelSet(dir / "again.vdb");
+    EXPECT_FALSE(again->saveFloatAsHalf());
+    EXPECT_GT(fs::file_size(dir / "again.vdb"), fs::file_size(dir / "half.vdb"));
+    std::size_t differ = 0;
+    auto backAcc = back->getConstAccessor();
+    for (auto it = again->cbeginValueAll(); it; ++it)
+        differ += backAcc.getValue(it.getCoord()) != *it;
+    EXPECT_EQ(differ, 0u);
+    // Voxel sizes where 16-bit floats lose their precision or overflow: refused, nothing left.
+    EXPECT_EQ(halfPrecisionProblem(h, 3.0), "");
+    EXPECT_NE(halfPrecisionProblem(5e-5, 3.0).find("under 6.1e-05"), std::string::npos);
+    EXPECT_NE(halfPrecisionProblem(30000.0, 3.0).find("end at 65504"), std::string::npos);
+    GridPtr speck = makeSphere({0, 0, 0}, 1e-3, 5e-5, 3);
+    EXPECT_NE(errorOf([&] { writeLevelSet(*speck, dir / "speck.vdb", half); }).find("6.1e-05"),
+              std::string::npos);
+    EXPECT_FALSE(fs::exists(dir / "speck.vdb"));
+}
+
 TEST(VdbFile, UnwritableTargetFailsCleanly) {
     ScratchDir dir;
     GridPtr g = makeSphere({0, 0, 0}, 0.5, 0.05, 3);
