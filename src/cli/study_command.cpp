@@ -128,8 +128,25 @@ std::string joined(const std::vector<std::string>& items) {
 
 // The closing lines of a study, its --json object and its exit code: done when every run
 // finished and the plots were drawn.
-int finishStudy(const StudyPlan& plan, const StudyResults& results, std::size_t reused,
-                const std::string& plotsError, const json& extra = json::object()) {
+// study --stats: where each run's measuring went, phase by phase.
+void printMeasurePhases(const StudyResults& results) {
+    std::fprintf(stderr, "%-36s %8s %8s %8s %9s %9s %10s %9s %10s\n",
+                 "measured in seconds:", "wall", "measure", "grid", "voxels", "crossings",
+                 "(count)", "vertices", "(count)");
+    for (const StudyRow& r : results.rows) {
+        if (!r.failure.empty()) continue;
+        const InterfaceError::Phases& p = r.error.phases;
+        const std::string run = r.script + " " + r.variant + " " + formatNumber(r.voxelSize);
+        std::fprintf(stderr, "%-36s %8.2f %8.2f %8.2f %9.2f %9.2f %10zu %9.2f %10zu\n", run.c_str(),
+                     r.wallSeconds, r.measureSeconds, r.gridMeasureSeconds, p.voxels, p.crossings,
+                     p.crossingCount, p.vertices, p.vertexCount);
+    }
+}
+
+int finishStudy(const StudyArgs& a, const StudyPlan& plan, const StudyResults& results,
+                std::size_t reused, const std::string& plotsError,
+                const json& extra = json::object()) {
+    if (a.stats) printMeasurePhases(results);
     const std::string csv = plan.dir + "/study.csv", report = plan.dir + "/report.md";
     const std::size_t failed = results.failedIds.size(), missing = results.missingIds.size();
     gOut.say("wrote " + csv + " and " + report + ": " + std::to_string(results.rows.size()) +
@@ -300,7 +317,7 @@ int runLocally(const StudyArgs& a, StudyPlan& plan) {
     }
     const StudyResults results = collectStudyResults(plan);
     const std::string plotsError = mergeStudy(plan, results);
-    return finishStudy(plan, results, reused, plotsError);
+    return finishStudy(a, plan, results, reused, plotsError);
 }
 
 // --run ID: one run of a planned study, as a Slurm task or another machine runs it.
@@ -338,24 +355,33 @@ int submitToSlurm(const StudyArgs& a, StudyPlan& plan) {
     std::size_t reused = 0;
     for (const PlannedRun& r : plan.runs)
         reused += runIsDone(plan, r) ? 1 : 0;
-    // The others' memory and time are scaled from the coarsest run of each script: it runs
-    // here first where it has not run yet.
+    // The others' memory and time are scaled from the runs of their script that finished:
+    // the first run of its coarsest voxel size runs here first where none has, and of the
+    // next coarsest too where a finer one remains (two sizes fit how time grows; one gives
+    // only an upper bound).
     ProgressLine progress(gOut.progress(), "study", "run");
     progress.setLinesEachTenth(false);
     for (std::size_t k = 0; k < plan.scripts.size(); ++k) {
-        std::optional<std::size_t> coarsest;
-        bool measured = false;
-        for (std::size_t i = 0; i < plan.runs.size(); ++i) {
-            const PlannedRun& r = plan.runs[i];
-            if (r.script != k) continue;
-            if (!coarsest) coarsest = i;
-            if (r.voxelSize == plan.runs[*coarsest].voxelSize && runIsDone(plan, r))
-                measured = true;
+        std::vector<std::size_t> sizes; // the first run of each voxel size, coarsest first
+        for (std::size_t i = 0; i < plan.runs.size(); ++i)
+            if (plan.runs[i].script == k &&
+                std::none_of(sizes.begin(), sizes.end(), [&](std::size_t p) {
+                    return plan.runs[p].voxelSize == plan.runs[i].voxelSize;
+                }))
+                sizes.push_back(i);
+        const std::vector<std::size_t> pilots(
+            sizes.begin(), sizes.begin() + std::ptrdiff_t(std::min<std::size_t>(
+                                               sizes.size() >= 3 ? 2 : 1, sizes.size())));
+        for (const std::size_t p : pilots) {
+            const PlannedRun& pilot = plan.runs[p];
+            const bool measured =
+                std::any_of(plan.runs.begin(), plan.runs.end(), [&](const auto& r) {
+                    return r.script == k && r.voxelSize == pilot.voxelSize && runIsDone(plan, r);
+                });
+            if (measured) continue;
+            const std::string which = "study: " + pilot.id + " (here, to estimate the others)";
+            progress.print(which + runLine(runHere(plan, pilot, which, segmentsMode(progress))));
         }
-        if (!coarsest || measured) continue;
-        const PlannedRun& pilot = plan.runs[*coarsest];
-        const std::string which = "study: " + pilot.id + " (here, to estimate the others)";
-        progress.print(which + runLine(runHere(plan, pilot, which, segmentsMode(progress))));
     }
     SlurmOptions o;
     o.maxRunning = a.maxRunning;
@@ -375,7 +401,7 @@ int submitToSlurm(const StudyArgs& a, StudyPlan& plan) {
     if (pending.empty()) {
         gOut.say("study: every run has a result; merging them here");
         const StudyResults results = collectStudyResults(plan);
-        return finishStudy(plan, results, reused, mergeStudy(plan, results));
+        return finishStudy(a, plan, results, reused, mergeStudy(plan, results));
     }
     const auto submitted = std::filesystem::file_time_type::clock::now();
     const SlurmSubmission jobs = submitStudy(plan, pending, o);
@@ -422,7 +448,8 @@ int submitToSlurm(const StudyArgs& a, StudyPlan& plan) {
             "); see " + plan.dir + "/slurm/logs/merge_" + jobs.merge + ".out");
     const StudyResults results = collectStudyResults(plan);
     const bool plotted = std::filesystem::exists(plan.dir + "/convergence.png");
-    return finishStudy(plan, results, reused, plotted ? "" : "plots: the merge job drew none", ids);
+    return finishStudy(a, plan, results, reused, plotted ? "" : "plots: the merge job drew none",
+                       ids);
 }
 
 } // namespace
@@ -445,6 +472,9 @@ CLI::App* addStudyCommand(CLI::App& app, StudyArgs& a) {
                           "What each run keeps beside its result: both (default), grids, meshes or "
                           "none");
     CLI::Option* half = study->add_flag("--half", a.half, kHalfHelp);
+    study->add_flag("--stats", a.stats,
+                    "Print where each run's measuring went: the grid's measures, the reference at "
+                    "the voxels, at the crossings between them and along the vertex normals");
     study->add_option("--jobs", a.jobs, "Runs at once here, the threads split between them")
         ->check(CLI::Range(1, 1024));
     study->add_option("--threads", *a.threads, "Worker threads (with --slurm: of each run)")
@@ -490,7 +520,7 @@ int runStudy(const StudyArgs& a) {
     if (a.merge) {
         const StudyPlan plan = readStudyPlan(a.dir);
         const StudyResults results = collectStudyResults(plan);
-        return finishStudy(plan, results, 0, mergeStudy(plan, results));
+        return finishStudy(a, plan, results, 0, mergeStudy(plan, results));
     }
     if (a.slurm) requireSlurm(a.wait); // before anything is planned or run
     StudyPlan plan = makePlan(a);

@@ -19,6 +19,7 @@ struct StudyArgs {
     // grid is written at half precision (once given, the plan keeps it).
     std::string keep;
     bool half = false;
+    bool stats = false; // print the measure's phases per run
     int jobs = 1;
     int* threads = nullptr; // the program's --threads (0: all cores)
     // One step of a study: plan only, list the runs without a result, run one, merge.

@@ -413,6 +413,15 @@ nlohmann::json studyRowJson(const StudyRow& r, bool allDigits) {
         else
             row[kColumns[c]] = std::stod(cell);
     }
+    // In a run's result, the whole run's time and where measuring's went (study --stats),
+    // beside the table's columns (which alone are a row everywhere else).
+    if (allDigits && r.failure.empty()) {
+        row["run_s"] = r.runSeconds;
+        const InterfaceError::Phases& p = r.error.phases;
+        row["measure_phases"] = {{"grid_s", r.gridMeasureSeconds}, {"voxels_s", p.voxels},
+                                 {"crossings_s", p.crossings},     {"vertices_s", p.vertices},
+                                 {"crossings", p.crossingCount},   {"vertices", p.vertexCount}};
+    }
     return row;
 }
 
@@ -454,7 +463,22 @@ StudyRow studyRowFromJson(const nlohmann::json& j, const std::string& where) {
         else if (notMeasuredIsNan(kColumns[c]) && j.value("failure", "") == "")
             cells[c] = "nan"; // no coarser run to compare with, or no exact reference
     }
-    return studyRowFromCells(cells, where);
+    StudyRow row = studyRowFromCells(cells, where);
+    // (Results written before these were kept have none: zeros.)
+    if (const auto t = j.find("run_s"); t != j.end() && t->is_number())
+        row.runSeconds = t->get<double>();
+    if (const auto p = j.find("measure_phases"); p != j.end() && p->is_object()) try {
+            InterfaceError::Phases& phases = row.error.phases;
+            row.gridMeasureSeconds = p->value("grid_s", 0.0);
+            phases.voxels = p->value("voxels_s", 0.0);
+            phases.crossings = p->value("crossings_s", 0.0);
+            phases.vertices = p->value("vertices_s", 0.0);
+            phases.crossingCount = p->value("crossings", std::size_t(0));
+            phases.vertexCount = p->value("vertices", std::size_t(0));
+        } catch (const nlohmann::json::exception&) {
+            throw FileError(where + ": 'measure_phases' is " + p->dump());
+        }
+    return row;
 }
 
 namespace {

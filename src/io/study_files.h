@@ -22,7 +22,8 @@ namespace sweepers {
 std::string studyCsv(const std::vector<StudyRow>& rows);
 // A row as a JSON object keyed by those columns: numbers as numbers, a cell the table
 // leaves empty (a failed run's measures, the coarsest run's order) as null. With
-// `allDigits`, every digit of a double (a run's result file); else as the table rounds them.
+// `allDigits`, every digit of a double and the whole run's time and measuring phases beside
+// them (a run's result file); else as the table rounds them.
 nlohmann::json studyRowJson(const StudyRow& row, bool allDigits = false);
 // The rows as an array of those objects, as the table rounds them.
 nlohmann::json studyJson(const std::vector<StudyRow>& rows);

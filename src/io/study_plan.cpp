@@ -13,6 +13,8 @@
 #include <unistd.h>
 #include <xxhash.h>
 
+#include "core/memory.h"
+#include "core/stopwatch.h"
 #include "io/atomic_file.h"
 #include "io/baked_tool.h"
 #include "io/mesh_file.h"
@@ -331,6 +333,7 @@ StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run, Interrupt
     std::filesystem::create_directories(dir, ec);
     if (ec) throw FileError(dir + ": cannot create the run's directory (" + ec.message() + ")");
     const StudyScript& source = plan.scripts[run.script];
+    const auto started = Clock::now();
     StudyRow row = plannedRow(plan, run);
     row.host = hostName();
     row.threads = int(loopThreads());
@@ -363,6 +366,10 @@ StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run, Interrupt
             if (!kept) std::filesystem::remove(path, ec);
         if (vdb) vdb->commit();
         if (mesh) mesh->commit();
+        // What a job running it needs: measuring and writing the files (the mesh through
+        // Assimp's copy of it) can take more than sculpting did.
+        done->row.peakRssMb = std::max(done->row.peakRssMb, peakResidentBytes() / double(1 << 20));
+        done->row.runSeconds = secondsSince(started);
         const std::string host = row.host;
         const int threads = row.threads;
         row = done->row;
@@ -389,11 +396,11 @@ StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run, Interrupt
 void estimateStudyRuns(StudyPlan& plan, int threads) {
     for (std::size_t k = 0; k < plan.scripts.size(); ++k) {
         // The script's finished runs, one per voxel size (the first variant that finished
-        // there), their time as the default engine's.
+        // there): their sculpting as the default engine's, and their measuring.
         struct Measured {
             StudyRow row;
             std::string id;
-            double seconds;
+            double sculpt, measure, rest; // rest: building the start and writing the files
         };
         std::vector<Measured> measured;
         for (const PlannedRun& r : plan.runs) {
@@ -403,21 +410,45 @@ void estimateStudyRuns(StudyPlan& plan, int threads) {
             if (std::any_of(measured.begin(), measured.end(),
                             [&](const Measured& m) { return m.row.voxelSize == row->voxelSize; }))
                 continue;
-            measured.push_back({*row, r.id, row->wallSeconds / variantCost(r.variant)});
+            measured.push_back(
+                {*row, r.id, row->wallSeconds / variantCost(r.variant), row->measureSeconds,
+                 std::max(0.0, row->runSeconds - row->wallSeconds - row->measureSeconds)});
         }
-        // Time grows as the band's voxels (1/h^2) times the sub-steps, which some strokes
-        // take per voxel (up to 1/h^3): the exponent fitted to the two finest runs where
-        // there are two, the bound 3 where there is one.
+        // A run's time is its sculpting and its measuring. Sculpting grows as the band's
+        // voxels (1/h^2) times the sub-steps, which some strokes take per voxel (up to
+        // 1/h^3); measuring as the voxels and crossings (1/h^2) times the history's
+        // deformations that reach them, fewer for each as the voxels shrink. Each exponent is
+        // fitted to the two finest runs where there are two, within [2, 3]; 3, an upper
+        // bound, where there is one. The rest (the start built, the files written) grows as
+        // the voxels.
         std::sort(measured.begin(), measured.end(), [](const Measured& a, const Measured& b) {
             return a.row.voxelSize > b.row.voxelSize;
         });
-        double exponent = 3.0;
+        double sculptExponent = 3.0, measureExponent = 3.0;
         if (measured.size() >= 2) {
             const Measured& coarse = measured[measured.size() - 2];
             const Measured& fine = measured.back();
-            exponent = std::clamp(std::log(fine.seconds / coarse.seconds) /
-                                      std::log(coarse.row.voxelSize / fine.row.voxelSize),
-                                  2.0, 3.0);
+            const double halvings = std::log(coarse.row.voxelSize / fine.row.voxelSize);
+            const auto fitted = [&](double a, double b) {
+                return a > 0.0 && b > 0.0 ? std::clamp(std::log(b / a) / halvings, 2.0, 3.0) : 3.0;
+            };
+            sculptExponent = fitted(coarse.sculpt, fine.sculpt);
+            measureExponent = fitted(coarse.measure, fine.measure);
+        }
+        // Memory grows with the band's voxels by what each voxel costs a run (the grid, the
+        // sampler's copies, the mesh, the reference's signs): fitted to the two finest runs
+        // once the finer one's grid holds a third of its memory (below, the program's own
+        // memory hides what a voxel costs), never under kRunBytesPerVoxel before.
+        double bytesPerVoxel = kRunBytesPerVoxel;
+        if (measured.size() >= 2) {
+            const StudyRow& coarse = measured[measured.size() - 2].row;
+            const StudyRow& fine = measured.back().row;
+            const double grown = double(fine.activeVoxels) - double(coarse.activeVoxels);
+            const double fitted =
+                grown > 0.0 ? (fine.peakRssMb - coarse.peakRssMb) * double(1 << 20) / grown : 0.0;
+            bytesPerVoxel = fine.peakRssMb >= 1.5 * kRunBaseMb && fitted > 0.0
+                                ? fitted
+                                : std::max(fitted, kRunBytesPerVoxel);
         }
         std::optional<StrokeScript> script;
         for (PlannedRun& r : plan.runs) {
@@ -433,9 +464,12 @@ void estimateStudyRuns(StudyPlan& plan, int threads) {
                 const double scale = b.voxelSize / r.voxelSize;
                 const double voxels = double(b.activeVoxels) * scale * scale;
                 r.memoryMb = b.peakRssMb + std::max(0.0, voxels - double(b.activeVoxels)) *
-                                               kRunBytesPerVoxel / double(1 << 20);
-                r.seconds = from->seconds * std::pow(scale, exponent) * variantCost(r.variant) *
-                            std::max(1.0, double(b.threads) / double(threads));
+                                               bytesPerVoxel / double(1 << 20);
+                r.seconds =
+                    (from->sculpt * std::pow(scale, sculptExponent) * variantCost(r.variant) +
+                     from->measure * std::pow(scale, measureExponent) +
+                     from->rest * scale * scale) *
+                    std::max(1.0, double(b.threads) / double(threads));
                 r.basis = "measured run " + from->id;
                 continue;
             }

@@ -110,6 +110,13 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
         return reference.near(Box(toEigen(grid.indexToWorld(b.min())),
                                   toEigen(grid.indexToWorld(b.max().offsetBy(1)))));
     };
+    InterfaceError e;
+    auto phaseStart = Clock::now();
+    // Ends a phase: its time into `seconds`.
+    const auto endPhase = [&](double& seconds) {
+        seconds = secondsSince(phaseStart);
+        phaseStart = Clock::now();
+    };
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, signLeaves.size()), [&](const auto& r) {
         pollInterrupt(interrupter);
         Tally& t = tallies.local();
@@ -124,6 +131,7 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
             }
         }
     });
+    endPhase(e.phases.voxels);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& r) {
         pollInterrupt(interrupter);
         Tally& t = tallies.local();
@@ -148,6 +156,10 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
             }
         }
     });
+    endPhase(e.phases.crossings);
+    for (const Tally& t : tallies)
+        e.phases.crossingCount += t.count;
+    e.phases.vertexCount = mesh.positions.size();
 
     // Mesh to reference: the nearest bracket along the normal that holds a crossing.
     std::vector<Eigen::Vector3d> onReference(mesh.positions.size());
@@ -175,11 +187,11 @@ InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
                 }
             }
         });
+    endPhase(e.phases.vertices);
 
     Tally all;
     for (const Tally& t : tallies)
         all.merge(t);
-    InterfaceError e;
     // Volumes by the divergence theorem, a tetrahedron from the origin per triangle; the
     // mesh's orientation gives both the same sign.
     for (const Eigen::Vector3i& tri : mesh.triangles) {
@@ -260,6 +272,7 @@ StudyRun runStudyCase(GridPtr start, const std::vector<Stroke>& strokes,
     row.euler = m.eulerCharacteristic;
     row.genus = m.genus;
     row.components = m.components;
+    row.gridMeasureSeconds = secondsSince(t2);
     if (exact) {
         row.error = interfaceError(*run.grid, run.mesh, reference, interrupter);
     } else {

@@ -48,6 +48,13 @@ struct InterfaceError {
     double meshVolume = 0.0, referenceVolume = 0.0;
     double volumeError() const { return meshVolume - referenceVolume; }
     static constexpr double kSearchVoxels = 3.0;
+    // What measuring took, phase by phase (seconds): the reference's sign at every active
+    // voxel, its crossings on the edges between them, and its crossings along the mesh's
+    // vertex normals; and how many crossings and vertices there were.
+    struct Phases {
+        double voxels = 0.0, crossings = 0.0, vertices = 0.0;
+        std::size_t crossingCount = 0, vertexCount = 0;
+    } phases;
 };
 InterfaceError interfaceError(const Grid& grid, const TriangleMesh& mesh,
                               const ExactReference& reference, Interrupter* interrupter = nullptr);
@@ -60,8 +67,13 @@ struct StudyRow {
     // After the run: measuring its grid (volume, area, topology) and its error against the
     // exact reference, which wallSeconds leaves out.
     double measureSeconds = 0.0;
-    // Peak resident memory during the run, its start grid included (the process's peak so
-    // far where the kernel cannot restart the count).
+    double gridMeasureSeconds = 0.0; // of it, the grid's volume, area and topology
+    // The whole run as a job sees it: its start built, sculpted, measured and its files
+    // written (0 where only sculpted and measured).
+    double runSeconds = 0.0;
+    // Peak resident memory during the run, its start grid included, and measuring and
+    // writing its files where the run wrote them (the process's peak so far where the
+    // kernel cannot restart the count).
     double peakRssMb = 0.0;
     std::size_t activeVoxels = 0;
     double volume = 0.0, volumeChangePct = 0.0, area = 0.0;

@@ -153,6 +153,26 @@ assert "## rigid_motion" in report and "## translate" in report, report
 print("two scripts, --jobs 2: the same table; plan estimates; one panel set per script")
 PY
 
+# --- --stats: where each run's measuring went, kept in its result, phases within measure_s
+"$cli" study -o "$tmp/jobs2" --merge --stats -q 2>"$tmp/stats"
+"$py" - "$tmp/stats" "$tmp/jobs2" <<'PY'
+import csv, json, sys
+lines = open(sys.argv[1]).read().splitlines()
+assert lines[0].split()[:5] == ["measured", "in", "seconds:", "wall", "measure"], lines
+rows = list(csv.DictReader(open(f"{sys.argv[2]}/study.csv")))
+assert len(lines) == 1 + len(rows), lines
+for line, row in zip(lines[1:], rows):
+    cells = line.split()
+    assert cells[:2] == [row["script"], row["variant"]], (line, row)
+    wall, measure, grid, voxels, crossings, n_crossings, vertices, n_vertices = map(float, cells[3:])
+    # (Five figures rounded to 0.01 each.)
+    assert 0 < grid + voxels + crossings + vertices <= measure + 0.025, line
+    # Each of the grid's crossings and each mesh vertex gave one error sample.
+    assert n_crossings + n_vertices == int(row["err_samples"]), (line, row["err_samples"])
+    assert n_crossings > 0 and n_vertices > 0, line
+print(f"--stats: the measure's phases of {len(rows)} runs, read back from their results")
+PY
+
 # --- a voxel size a double does not hold exactly: its run is found again ----------------
 "$cli" study "$data/studies/rigid_motion.json" -o "$tmp/odd" --voxel-sizes 0.07 -q
 "$cli" study "$data/studies/rigid_motion.json" -o "$tmp/odd" --voxel-sizes 0.07 2>"$tmp/err"

@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "io/study_files.h"
 #include "io/study_plan.h"
 #include "scratch_dir.h"
 
@@ -109,4 +110,63 @@ TEST(StudyPlan, DigestsChangeWhenAndOnlyWhenTheirInputsDo) {
     for (const auto& [id, digest] : resized.runs)
         kept += scriptEdited.runs.count(id);
     EXPECT_EQ(kept, 4u);
+}
+
+namespace {
+
+// A finished run's result, as executeStudyRun writes it, with the figures given.
+void finish(const StudyPlan& plan, const PlannedRun& run, double wall, double measure,
+            double peakMb, std::size_t activeVoxels, double whole = 0.0) {
+    StudyRow row;
+    row.script = plan.scripts[run.script].name;
+    row.variant = variantName(run.variant);
+    row.voxelSize = run.voxelSize;
+    row.wallSeconds = wall;
+    row.measureSeconds = measure;
+    row.runSeconds = whole;
+    row.peakRssMb = peakMb;
+    row.activeVoxels = activeVoxels;
+    row.threads = 2;
+    row.host = "here";
+    const std::string dir = runDirectory(plan, run);
+    std::filesystem::create_directories(dir);
+    const nlohmann::json result = {{"format", "sweepers study result 1"},
+                                   {"id", run.id},
+                                   {"digest", run.digest},
+                                   {"version", plan.version},
+                                   {"row", studyRowJson(row, true)}};
+    write(dir + "/result.json", result.dump());
+}
+
+} // namespace
+
+TEST(StudyPlan, EstimatesFitSculptingMeasuringAndMemoryToTheTwoFinestRuns) {
+    const test::ScratchDir dir;
+    write(dir / "sphere.json", kSphereScript);
+    StudyPlan plan = planStudy({dir / "sphere.json"}, {1.0 / 16, 1.0 / 32, 1.0 / 64, 1.0 / 128},
+                               {StudyVariant::Corrected}, dir / "study", false);
+    ASSERT_EQ(plan.runs.size(), 4u);
+    const auto estimate = [&](std::size_t i) {
+        estimateStudyRuns(plan, 2);
+        return plan.runs[i];
+    };
+    // One run: time grows as 1/h^3 at most, sculpting and measuring alike (an upper bound).
+    finish(plan, plan.runs[0], 1.0, 2.0, 70.0, 1000000);
+    EXPECT_NEAR(estimate(2).seconds, 3.0 * 64, 1e-9);
+    // Two: sculpting grew 8 times (1/h^3), measuring 4 times (1/h^2); each keeps its rate.
+    finish(plan, plan.runs[1], 8.0, 8.0, 80.0, 4000000);
+    EXPECT_NEAR(estimate(2).seconds, 8.0 * 8 + 8.0 * 4, 1e-9);
+    EXPECT_NEAR(estimate(3).seconds, 8.0 * 64 + 8.0 * 16, 1e-9);
+    EXPECT_EQ(estimate(3).basis, "measured run " + plan.runs[1].id);
+    // Memory: while the program's own memory hides what a voxel costs (80 MB), at least
+    // kRunBytesPerVoxel a voxel (the fit says 3.5 bytes).
+    const double mb = double(1 << 20);
+    EXPECT_NEAR(estimate(2).memoryMb, 80.0 + 12e6 * 160 / mb, 1e-6);
+    // Once the grid holds a third of the run's memory, what a voxel cost between the two.
+    // The rest of the whole run (the start built, the files written: 4 s) grows as the
+    // voxels.
+    finish(plan, plan.runs[2], 64.0, 32.0, 300.0, 16000000, 100.0);
+    const double perVoxel = (300.0 - 80.0) * mb / 12e6; // 19.2 bytes
+    EXPECT_NEAR(estimate(3).memoryMb, 300.0 + 48e6 * perVoxel / mb, 1e-6);
+    EXPECT_NEAR(estimate(3).seconds, 64.0 * 8 + 32.0 * 4 + 4.0 * 4, 1e-9);
 }
