@@ -18,7 +18,8 @@ cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" || fail "$(cat "
 for f in bin/sweepers bin/sweepers-cli share/sweepers/shaders/clay.vert \
   share/sweepers/shaders/clay.frag share/sweepers/examples/drag.json \
   share/sweepers/examples/tools/finger.vdb share/doc/sweepers/README.md \
-  share/doc/sweepers/cli.md share/doc/sweepers/stroke-scripts.md share/doc/sweepers/LICENSE; do
+  share/doc/sweepers/cli.md share/doc/sweepers/stroke-scripts.md share/doc/sweepers/LICENSE \
+  share/blender/scripts/addons/sweepers_blender/__init__.py; do
   [ -e "$prefix/$f" ] || fail "cmake --install put no $f"
 done
 echo "installed: programs, shaders, examples and guides under $prefix"
@@ -70,7 +71,8 @@ cpack -G DEB --config "$build/CPackConfig.cmake" -B "$tmp/pkg" >"$tmp/cpack.log"
 deb=$(ls "$tmp"/pkg/sweepers_*.deb)
 dpkg-deb -c "$deb" >"$tmp/contents"
 for f in ./usr/bin/sweepers ./usr/bin/sweepers-cli ./usr/share/sweepers/shaders/clay.vert \
-  ./usr/share/sweepers/examples/drag.json; do
+  ./usr/share/sweepers/examples/drag.json \
+  ./usr/share/blender/scripts/addons/sweepers_blender/__init__.py; do
   grep -q " $f\$" "$tmp/contents" || fail "$(basename "$deb") holds no $f"
 done
 if [ -e "$build/python" ]; then
