@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: Apache-2.0
 # The layers of src/ only depend downwards:
 #   core < vdb < tools < deform < levelset < mesh < sculpt < study < io < document < app, cli
-#   < python
+#   < python < blender (the Blender add-on: Python on the module, no C++)
 # A file may include headers of its own layer and of layers below it; app and cli do not
 # include each other; the window-free part of app (app_core) includes no GL, GLFW window
 # or ImGui code. CMake links one library per layer in the same order.
@@ -12,7 +12,7 @@ rank() {
   case $1 in
     core) echo 0 ;; vdb) echo 1 ;; tools) echo 2 ;; deform) echo 3 ;; levelset) echo 4 ;;
     mesh) echo 5 ;; sculpt) echo 6 ;; study) echo 7 ;; io) echo 8 ;; document) echo 9 ;;
-    app | cli) echo 10 ;; python) echo 11 ;;
+    app | cli) echo 10 ;; python) echo 11 ;; blender) echo 12 ;;
     *) echo "unknown layer $1" >&2; exit 2 ;;
   esac
 }
@@ -21,6 +21,7 @@ for dir in "$src"/*/; do
   layer=$(basename "$dir")
   own=$(rank "$layer")
   for file in "$dir"*; do
+    [ -f "$file" ] || continue
     while IFS= read -r included; do
       target=${included%%/*}
       theirs=$(rank "$target")

@@ -10,6 +10,7 @@
 
 #include "app/input_replay.h"
 #include "app/modeler.h"
+#include "core/install_paths.h"
 #include "core/limits.h"
 #include "core/memory.h"
 #include "io/stroke_script.h"
@@ -28,6 +29,10 @@ struct CommandLine {
 
 void addOptions(CLI::App& app, CommandLine& c) {
     app.set_version_flag("--version", "sweepers " SWEEPERS_VERSION);
+    const sweepers::ProgramPlaces places = sweepers::programPlaces();
+    app.footer("Examples: " + places.examples + " (sweepers " + places.examples +
+               "/horn.json)\nGuides: " + places.guides +
+               "/README.md and docs/ beside it (modeler.md for every key)");
     app.add_option("file", c.options.open, "a .vdb level set or a stroke script (.json) to open");
     app.add_option("--script", c.script, "a stroke script to open (same as giving it as file)");
     app.add_option("--voxel-size", c.options.voxelSize, "voxel size of a new sphere")

@@ -25,6 +25,7 @@
 #include "cli/progress.h"
 #include "cli/study_command.h"
 #include "core/format.h"
+#include "core/install_paths.h"
 #include "core/limits.h"
 #include "core/memory.h"
 #include "io/atomic_file.h"
@@ -595,6 +596,10 @@ int runAnimate(const AnimateArgs& a) {
 static int run(int argc, char** argv) {
     CLI::App app{"sweepers-cli: sculpt narrow-band level sets with sweepers"};
     app.set_version_flag("--version", "sweepers-cli " SWEEPERS_VERSION);
+    const ProgramPlaces places = programPlaces();
+    app.footer("Examples: " + places.examples + " (sweepers-cli apply " + places.examples +
+               "/horn.json -o horn.vdb)\nGuides: " + places.guides +
+               "/README.md and docs/ beside it (cli.md, stroke-scripts.md, studies.md)");
     app.require_subcommand(1);
     int threads = 0;
     app.add_option("--threads", threads, "Worker threads (default: all cores)")

@@ -250,10 +250,25 @@ double voxelSizeFrom(const py::object& value) {
     return h;
 }
 
+// numpy, which makes every array the module takes or hands over: where it is missing, said
+// in the user's words with the Debian package that brings it (not a bare ModuleNotFoundError
+// from deep inside pybind11).
+void requireNumpy(const char* what) {
+    try {
+        py::module_::import("numpy");
+    } catch (const py::error_already_set&) {
+        throw py::import_error(std::string(what) +
+                               ": numpy is not installed (Debian: python3-numpy, for "
+                               "/usr/bin/python3)");
+    }
+}
+
 using Points = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-std::vector<Eigen::Vector3d> pointsOf(const Points& points) {
-    if (points.ndim() != 2 || points.shape(1) != 3)
+std::vector<Eigen::Vector3d> pointsOf(const py::object& given, const char* what) {
+    requireNumpy(what);
+    const Points points = Points::ensure(given);
+    if (!points || points.ndim() != 2 || points.shape(1) != 3)
         throw std::invalid_argument("points: an n x 3 array");
     std::vector<Eigen::Vector3d> p(std::size_t(points.shape(0)));
     const auto in = points.unchecked<2>();
@@ -263,6 +278,7 @@ std::vector<Eigen::Vector3d> pointsOf(const Points& points) {
 }
 
 py::array_t<double> arrayOf(const std::vector<double>& values) {
+    requireNumpy("arrays");
     py::array_t<double> out(py::ssize_t(values.size()));
     std::copy(values.begin(), values.end(), out.mutable_data());
     return out;
@@ -335,14 +351,15 @@ template <typename Class, typename With> void addShapeMethods(Class& cls, const 
         .def(
             "mesh",
             [with](const Self& s) {
+                requireNumpy("mesh"); // before the surface is made
                 return meshArrays(with(s, [](const Shape& x) { return x.mesh(); }));
             },
             "The surface as (vertices float32 n x 3, triangles int32 m x 3): the welded mesh "
             "that `sweepers-cli apply --mesh` exports.")
         .def(
             "sample",
-            [with](const Self& s, const Points& points) {
-                const std::vector<Eigen::Vector3d> p = pointsOf(points);
+            [with](const Self& s, const py::object& points) {
+                const std::vector<Eigen::Vector3d> p = pointsOf(points, "sample");
                 return arrayOf(with(s, [&](const Shape& x) { return x.sample(p); }));
             },
             py::arg("points"),
@@ -350,8 +367,8 @@ template <typename Class, typename With> void addShapeMethods(Class& cls, const 
             "points.")
         .def(
             "exact_distance",
-            [with](const Self& s, const Points& points) {
-                const std::vector<Eigen::Vector3d> p = pointsOf(points);
+            [with](const Self& s, const py::object& points) {
+                const std::vector<Eigen::Vector3d> p = pointsOf(points, "exact_distance");
                 return arrayOf(with(s, [&](const Shape& x) { return x.exactDistance(p); }));
             },
             py::arg("points"),
@@ -363,8 +380,8 @@ template <typename Class, typename With> void addShapeMethods(Class& cls, const 
             "no tool reached, it is the distance to the start's surface (docs/python.md).")
         .def(
             "exact_value",
-            [with](const Self& s, const Points& points) {
-                const std::vector<Eigen::Vector3d> p = pointsOf(points);
+            [with](const Self& s, const py::object& points) {
+                const std::vector<Eigen::Vector3d> p = pointsOf(points, "exact_value");
                 return arrayOf(with(s, [&](const Shape& x) { return x.exactValue(p); }));
             },
             py::arg("points"),

@@ -82,6 +82,12 @@ json_keys "$tmp/info.json" file grid voxel_size active_voxels volume area genus 
   euler_characteristic mesh_volume mesh_triangles
 "$cli" check "$data/pull.json" --json >"$tmp/check.json"
 json_keys "$tmp/check.json" script valid strokes voxel_size deformations
+# In the tree it was built in, --help names the checkout's examples and guides.
+"$cli" --help >"$tmp/help"
+grep -qx "Examples: $data (sweepers-cli apply $data/horn.json -o horn.vdb)" "$tmp/help" ||
+  fail "--help: $(tail -2 "$tmp/help")"
+grep -qx "Guides: $(dirname "$data")/README.md and docs/ beside it (cli.md, stroke-scripts.md, studies.md)" \
+  "$tmp/help" || fail "--help: $(tail -2 "$tmp/help")"
 "$cli" study "$data/studies/rigid_motion.json" -o "$tmp/js" --voxel-sizes 1/8,1/16 --json \
   >"$tmp/study.json" 2>/dev/null
 json_keys "$tmp/study.json" script dir csv report runs reused failed files

@@ -18,7 +18,8 @@ cmake --install "$build" --prefix "$prefix" >"$tmp/install.log" || fail "$(cat "
 for f in bin/sweepers bin/sweepers-cli share/sweepers/shaders/clay.vert \
   share/sweepers/shaders/clay.frag share/sweepers/examples/drag.json \
   share/sweepers/examples/tools/finger.vdb share/doc/sweepers/README.md \
-  share/doc/sweepers/cli.md share/doc/sweepers/stroke-scripts.md share/doc/sweepers/LICENSE \
+  share/doc/sweepers/docs/cli.md share/doc/sweepers/docs/stroke-scripts.md \
+  share/doc/sweepers/docs/images/modeler.png share/doc/sweepers/LICENSE \
   share/blender/scripts/addons/sweepers_blender/__init__.py; do
   [ -e "$prefix/$f" ] || fail "cmake --install put no $f"
 done
@@ -33,6 +34,23 @@ ASAN_OPTIONS=$asan "$prefix/bin/sweepers-cli" apply "$examples/finger.json" -o f
   --voxel-size 0.05 -q --json >finger.json || fail "the installed sweepers-cli failed"
 "$py" -c 'import json, sys; j = json.load(open(sys.argv[1])); assert j["topology"]["genus"] == 0, j' \
   finger.json
+# --help says where the examples and guides are, and its example works as printed.
+footer=$("$prefix/bin/sweepers-cli" --help | grep "^Examples: ") || fail "sweepers-cli --help names no examples"
+[ "$footer" = "Examples: $prefix/share/sweepers/examples (sweepers-cli apply $prefix/share/sweepers/examples/horn.json -o horn.vdb)" ] ||
+  fail "sweepers-cli --help: $footer"
+command=$(echo "$footer" | sed 's/^[^(]*(//; s/)$//; s/^sweepers-cli //')
+# shellcheck disable=SC2086 # the example's words, as a user pastes them
+ASAN_OPTIONS=$asan "$prefix/bin/sweepers-cli" $command -q || fail "the --help example failed: $command"
+[ -s horn.vdb ] || fail "the --help example wrote no horn.vdb"
+guides=$("$prefix/bin/sweepers-cli" --help | sed -n 's/^Guides: \([^ ]*\)\/README.md .*/\1/p')
+[ "$guides" = "$prefix/share/doc/sweepers" ] || fail "sweepers-cli --help: guides at '$guides'"
+# The installed README's links and pictures resolve.
+grep -o '](docs/[^)]*)' "$guides/README.md" | sed 's/^](//; s/)$//; s/#.*//' | sort -u | while read -r link; do
+  [ -e "$guides/$link" ] || fail "the installed README links to $link, which is not installed"
+done
+ASAN_OPTIONS=$asan "$prefix/bin/sweepers" --help | grep -qx "Examples: $prefix/share/sweepers/examples (sweepers $prefix/share/sweepers/examples/horn.json)" ||
+  fail "sweepers --help: $("$prefix/bin/sweepers" --help | tail -2)"
+echo "installed --help: examples and guides named, the example runs, the README's links resolve"
 echo '{"events": []}' >none.json
 # The installed modeler must find its installed shaders: only a modeler in its build tree
 # reads the source tree's (src/app/gl_renderer.cpp).
