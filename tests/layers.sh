@@ -2,7 +2,8 @@
 # SPDX-License-Identifier: Apache-2.0
 # The layers of src/ only depend downwards:
 #   core < vdb < tools < deform < levelset < mesh < sculpt < study < io < document < app, cli
-#   < python < blender (the Blender add-on: Python on the module, no C++)
+#   < python < blender (the Blender add-on: Python on the module, no C++); src/package holds
+#   the package's own files (copyright, menu entry, icon), no code
 # A file may include headers of its own layer and of layers below it; app and cli do not
 # include each other; the window-free part of app (app_core) includes no GL, GLFW window
 # or ImGui code. CMake links one library per layer in the same order.
@@ -12,7 +13,7 @@ rank() {
   case $1 in
     core) echo 0 ;; vdb) echo 1 ;; tools) echo 2 ;; deform) echo 3 ;; levelset) echo 4 ;;
     mesh) echo 5 ;; sculpt) echo 6 ;; study) echo 7 ;; io) echo 8 ;; document) echo 9 ;;
-    app | cli) echo 10 ;; python) echo 11 ;; blender) echo 12 ;;
+    app | cli) echo 10 ;; python) echo 11 ;; blender) echo 12 ;; package) echo 13 ;;
     *) echo "unknown layer $1" >&2; exit 2 ;;
   esac
 }

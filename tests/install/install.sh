@@ -20,9 +20,23 @@ for f in bin/sweepers bin/sweepers-cli share/sweepers/shaders/clay.vert \
   share/sweepers/examples/tools/finger.vdb share/doc/sweepers/README.md \
   share/doc/sweepers/docs/cli.md share/doc/sweepers/docs/stroke-scripts.md \
   share/doc/sweepers/docs/images/modeler.png share/doc/sweepers/LICENSE \
-  share/blender/scripts/addons/sweepers_blender/__init__.py; do
+  share/blender/scripts/addons/sweepers_blender/__init__.py share/doc/sweepers/copyright \
+  share/applications/sweepers.desktop share/icons/hicolor/scalable/apps/sweepers.svg \
+  share/mime/packages/sweepers.xml; do
   [ -e "$prefix/$f" ] || fail "cmake --install put no $f"
 done
+# The menu entry, its icon and the .vdb type are what the desktop's tools accept; the
+# copyright file is Debian's machine-readable format.
+desktop-file-validate "$prefix/share/applications/sweepers.desktop" ||
+  fail "desktop-file-validate refuses sweepers.desktop"
+grep -qx "Exec=sweepers %f" "$prefix/share/applications/sweepers.desktop" || fail "the menu entry runs no sweepers"
+xmllint --noout "$prefix/share/icons/hicolor/scalable/apps/sweepers.svg" \
+  "$prefix/share/mime/packages/sweepers.xml" || fail "the icon or the MIME type is not well-formed"
+copyright=$prefix/share/doc/sweepers/copyright
+head -1 "$copyright" | grep -qx "Format: https://www.debian.org/doc/packaging-manuals/copyright-format/1.0/" ||
+  fail "the copyright file is not in Debian's format"
+grep -qx "License: Apache-2.0" "$copyright" && grep -qx "License: Expat" "$copyright" ||
+  fail "the copyright file names neither licence"
 echo "installed: programs, shaders, examples and guides under $prefix"
 
 # --- the installed programs, from another directory ------------------------------------
@@ -90,7 +104,8 @@ deb=$(ls "$tmp"/pkg/sweepers_*.deb)
 dpkg-deb -c "$deb" >"$tmp/contents"
 for f in ./usr/bin/sweepers ./usr/bin/sweepers-cli ./usr/share/sweepers/shaders/clay.vert \
   ./usr/share/sweepers/examples/drag.json \
-  ./usr/share/blender/scripts/addons/sweepers_blender/__init__.py; do
+  ./usr/share/blender/scripts/addons/sweepers_blender/__init__.py \
+  ./usr/share/doc/sweepers/copyright ./usr/share/applications/sweepers.desktop; do
   grep -q " $f\$" "$tmp/contents" || fail "$(basename "$deb") holds no $f"
 done
 if [ -e "$build/python" ]; then
