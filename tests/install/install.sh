@@ -112,6 +112,13 @@ if [ -e "$build/python" ]; then
   grep -q " ./usr/lib/python3/dist-packages/sweepers\..*\.so\$" "$tmp/contents" ||
     fail "$(basename "$deb") holds no Python module in /usr/lib/python3/dist-packages"
 fi
+# Its programs and module are stripped.
+dpkg-deb -x "$deb" "$tmp/unpacked"
+for f in "$tmp"/unpacked/usr/bin/sweepers "$tmp"/unpacked/usr/bin/sweepers-cli \
+  "$tmp"/unpacked/usr/lib/python3/dist-packages/sweepers.*.so; do
+  [ -e "$f" ] || continue
+  file -b "$f" | grep -q ", stripped" || fail "$(basename "$f") is not stripped: $(file -b "$f")"
+done
 depends=$(dpkg-deb -f "$deb" Depends)
 # Every package it depends on is one Debian has (here, installed by the build's own needs).
 for p in $(echo "$depends" | tr ',' '\n' | sed 's/(.*//; s/|.*//' | tr -d ' '); do
