@@ -366,8 +366,8 @@ StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run, Interrupt
             if (!kept) std::filesystem::remove(path, ec);
         if (vdb) vdb->commit();
         if (mesh) mesh->commit();
-        // What a job running it needs: measuring and writing the files (the mesh through
-        // Assimp's copy of it) can take more than sculpting did.
+        // What a job running it needs: measuring and above all writing the files can take
+        // more memory than sculpting did.
         done->row.peakRssMb = std::max(done->row.peakRssMb, peakResidentBytes() / double(1 << 20));
         done->row.runSeconds = secondsSince(started);
         const std::string host = row.host;
