@@ -79,9 +79,7 @@ int totalThreads(const StudyArgs& a) {
 // --keep and --half, given, replace what the plan keeps for the runs still to run.
 void applyOutputs(const StudyArgs& a, StudyPlan& plan) {
     if (!a.keep.empty()) {
-        const std::optional<StudyOutputs> kept = parseKept(a.keep);
-        if (!kept)
-            throw UsageError("--keep: '" + a.keep + "' is not one of both, grids, meshes, none");
+        const std::optional<StudyOutputs> kept = parseKept(a.keep); // checked by makePlan
         plan.outputs.grids = kept->grids;
         plan.outputs.meshes = kept->meshes;
     }
@@ -89,6 +87,8 @@ void applyOutputs(const StudyArgs& a, StudyPlan& plan) {
 }
 
 StudyPlan makePlan(const StudyArgs& a) {
+    if (!a.keep.empty() && !parseKept(a.keep))
+        throw UsageError("--keep: '" + a.keep + "' is not one of both, grids, meshes, none");
     if (a.scripts.empty()) {
         if (!std::filesystem::exists(a.dir + "/plan.json"))
             throw UsageError("study: no script given, and " + a.dir +

@@ -464,20 +464,32 @@ StudyRow studyRowFromJson(const nlohmann::json& j, const std::string& where) {
             cells[c] = "nan"; // no coarser run to compare with, or no exact reference
     }
     StudyRow row = studyRowFromCells(cells, where);
-    // (Results written before these were kept have none: zeros.)
-    if (const auto t = j.find("run_s"); t != j.end() && t->is_number())
-        row.runSeconds = t->get<double>();
-    if (const auto p = j.find("measure_phases"); p != j.end() && p->is_object()) try {
-            InterfaceError::Phases& phases = row.error.phases;
-            row.gridMeasureSeconds = p->value("grid_s", 0.0);
-            phases.voxels = p->value("voxels_s", 0.0);
-            phases.crossings = p->value("crossings_s", 0.0);
-            phases.vertices = p->value("vertices_s", 0.0);
-            phases.crossingCount = p->value("crossings", std::size_t(0));
-            phases.vertexCount = p->value("vertices", std::size_t(0));
-        } catch (const nlohmann::json::exception&) {
-            throw FileError(where + ": 'measure_phases' is " + p->dump());
-        }
+    // (Results written before these were kept have none: zeros.) A damaged figure is refused,
+    // not trusted: an estimate scaled from it would ask a cluster for anything.
+    const auto seconds = [&](const nlohmann::json& in, const char* key) {
+        const auto it = in.find(key);
+        if (it == in.end()) return 0.0;
+        const double v = it->is_number() ? it->get<double>() : -1.0;
+        if (!(v >= 0.0 && v <= kMaxCount))
+            throw FileError(where + ": '" + key + "' is " + it->dump() + ", not a figure");
+        return v;
+    };
+    const auto count = [&](const nlohmann::json& in, const char* key) {
+        const double v = seconds(in, key);
+        if (v != std::floor(v)) throw FileError(where + ": '" + key + "' is not a count");
+        return std::size_t(v);
+    };
+    row.runSeconds = seconds(j, "run_s");
+    if (const auto p = j.find("measure_phases"); p != j.end()) {
+        if (!p->is_object()) throw FileError(where + ": 'measure_phases' is " + p->dump());
+        InterfaceError::Phases& phases = row.error.phases;
+        row.gridMeasureSeconds = seconds(*p, "grid_s");
+        phases.voxels = seconds(*p, "voxels_s");
+        phases.crossings = seconds(*p, "crossings_s");
+        phases.vertices = seconds(*p, "vertices_s");
+        phases.crossingCount = count(*p, "crossings");
+        phases.vertexCount = count(*p, "vertices");
+    }
     return row;
 }
 

@@ -363,7 +363,9 @@ StudyRow executeStudyRun(const StudyPlan& plan, const PlannedRun& run, Interrupt
         if (plan.outputs.meshes) mesh.emplace(prepareMesh(done->mesh, meshPath));
         for (const auto& [kept, path] :
              {std::pair{plan.outputs.grids, gridPath}, std::pair{plan.outputs.meshes, meshPath}})
-            if (!kept) std::filesystem::remove(path, ec);
+            if (!kept && !std::filesystem::remove(path, ec) && ec)
+                throw FileError(path + ": cannot remove what the plan no longer keeps (" +
+                                ec.message() + ")");
         if (vdb) vdb->commit();
         if (mesh) mesh->commit();
         // What a job running it needs: measuring and above all writing the files can take

@@ -324,6 +324,14 @@ py::object toPyopenvdb(const std::string& bytes) {
 // computed without the GIL (and, for a Sculptor, while no other thread sculpts it).
 template <typename Class, typename With> void addShapeMethods(Class& cls, const With& with) {
     using Self = typename Class::type;
+    // A method that evaluates the shape at an n x 3 array of points, by `evaluate`.
+    using AtPoints = std::vector<double> (Shape::*)(const std::vector<Eigen::Vector3d>&) const;
+    const auto atPoints = [with](AtPoints evaluate, const char* name) {
+        return [with, evaluate, name](const Self& s, const py::object& points) {
+            const std::vector<Eigen::Vector3d> p = pointsOf(points, name);
+            return arrayOf(with(s, [&](const Shape& x) { return (x.*evaluate)(p); }));
+        };
+    };
     cls.def_property_readonly(
            "volume",
            [with](const Self& s) {
@@ -356,39 +364,21 @@ template <typename Class, typename With> void addShapeMethods(Class& cls, const 
             },
             "The surface as (vertices float32 n x 3, triangles int32 m x 3): the welded mesh "
             "that `sweepers-cli apply --mesh` exports.")
-        .def(
-            "sample",
-            [with](const Self& s, const py::object& points) {
-                const std::vector<Eigen::Vector3d> p = pointsOf(points, "sample");
-                return arrayOf(with(s, [&](const Shape& x) { return x.sample(p); }));
-            },
-            py::arg("points"),
-            "The grid's signed distance (trilinear, negative inside) at an n x 3 array of "
-            "points.")
-        .def(
-            "exact_distance",
-            [with](const Self& s, const py::object& points) {
-                const std::vector<Eigen::Vector3d> p = pointsOf(points, "exact_distance");
-                return arrayOf(with(s, [&](const Shape& x) { return x.exactDistance(p); }));
-            },
-            py::arg("points"),
-            "The signed distance to the exact shape, to first order, at an n x 3 array of "
-            "points: exact_value over the length of its gradient. Zero on the exact surface "
-            "and negative inside; exact where the history carries the start rigidly and the "
-            "start is a distance (a sphere); near the surface elsewhere, off by the square of "
-            "the distance. Away from the surface it is not the distance to the shape: where "
-            "no tool reached, it is the distance to the start's surface (docs/python.md).")
-        .def(
-            "exact_value",
-            [with](const Self& s, const py::object& points) {
-                const std::vector<Eigen::Vector3d> p = pointsOf(points, "exact_value");
-                return arrayOf(with(s, [&](const Shape& x) { return x.exactValue(p); }));
-            },
-            py::arg("points"),
-            "The exact shape's implicit function at an n x 3 array of points: the start's "
-            "value at the point the inverse of every deformation applied takes them to, the "
-            "reference `study` measures against; negative inside, zero on the exact surface, "
-            "stretched or squeezed where the tools stretched or squeezed space.")
+        .def("sample", atPoints(&Shape::sample, "sample"), py::arg("points"),
+             "The grid's signed distance (trilinear, negative inside) at an n x 3 array of "
+             "points.")
+        .def("exact_distance", atPoints(&Shape::exactDistance, "exact_distance"), py::arg("points"),
+             "The signed distance to the exact shape, to first order, at an n x 3 array of "
+             "points: exact_value over the length of its gradient. Zero on the exact surface "
+             "and negative inside; exact where the history carries the start rigidly and the "
+             "start is a distance (a sphere); near the surface elsewhere, off by the square of "
+             "the distance. Away from the surface it is not the distance to the shape: where "
+             "no tool reached, it is the distance to the start's surface (docs/python.md).")
+        .def("exact_value", atPoints(&Shape::exactValue, "exact_value"), py::arg("points"),
+             "The exact shape's implicit function at an n x 3 array of points: the start's "
+             "value at the point the inverse of every deformation applied takes them to, the "
+             "reference `study` measures against; negative inside, zero on the exact surface, "
+             "stretched or squeezed where the tools stretched or squeezed space.")
         .def(
             "to_vdb_bytes",
             [with](const Self& s) {

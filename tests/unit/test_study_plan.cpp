@@ -169,4 +169,11 @@ TEST(StudyPlan, EstimatesFitSculptingMeasuringAndMemoryToTheTwoFinestRuns) {
     const double perVoxel = (300.0 - 80.0) * mb / 12e6; // 19.2 bytes
     EXPECT_NEAR(estimate(3).memoryMb, 300.0 + 48e6 * perVoxel / mb, 1e-6);
     EXPECT_NEAR(estimate(3).seconds, 64.0 * 8 + 32.0 * 4 + 4.0 * 4, 1e-9);
+    // A damaged figure is no result, not an estimate of anything: the run is left out.
+    const std::string result = runDirectory(plan, plan.runs[2]) + "/result.json";
+    std::ifstream in(result);
+    nlohmann::json damaged = nlohmann::json::parse(in);
+    damaged["row"]["run_s"] = 1e300;
+    write(result, damaged.dump());
+    EXPECT_EQ(estimate(3).basis, "measured run " + plan.runs[1].id);
 }

@@ -121,6 +121,17 @@ def show_film_frame(scene, *_):
             obj.data = mesh
 
 
+def _imported(operator, make):
+    """An import operator's ending: the object made, or the reason in one line."""
+    try:
+        obj = make()
+    except SweepersError as e:
+        operator.report({"ERROR"}, f"Sweepers: {e}")
+        return {"CANCELLED"}
+    operator.report({"INFO"}, f"Sweepers: imported {obj.name}")
+    return {"FINISHED"}
+
+
 class IMPORT_MESH_OT_sweepers_vdb(bpy.types.Operator, ImportHelper):
     """Import a Sweepers level set (.vdb) as a mesh of its zero level, or a film of them"""
     bl_idname = "import_mesh.sweepers_vdb"
@@ -135,16 +146,8 @@ class IMPORT_MESH_OT_sweepers_vdb(bpy.types.Operator, ImportHelper):
         default=False)
 
     def execute(self, context):
-        try:
-            if self.sequence:
-                obj = import_film(context, self.filepath)
-            else:
-                obj = import_level_set(context, self.filepath)
-        except SweepersError as e:
-            self.report({"ERROR"}, f"Sweepers: {e}")
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"Sweepers: imported {obj.name}")
-        return {"FINISHED"}
+        return _imported(self, lambda: (import_film if self.sequence else import_level_set)(
+            context, self.filepath))
 
 
 def import_level_set(context, path):
@@ -187,13 +190,7 @@ class IMPORT_MESH_OT_sweepers_script(bpy.types.Operator, ImportHelper):
         default=0.0, min=0.0, soft_max=0.1, precision=4)
 
     def execute(self, context):
-        try:
-            obj = import_script(context, self.filepath, self.voxel_size)
-        except SweepersError as e:
-            self.report({"ERROR"}, f"Sweepers: {e}")
-            return {"CANCELLED"}
-        self.report({"INFO"}, f"Sweepers: imported {obj.name}")
-        return {"FINISHED"}
+        return _imported(self, lambda: import_script(context, self.filepath, self.voxel_size))
 
 
 def _applied(path, voxel_size):
