@@ -748,6 +748,11 @@ static int run(int argc, char** argv) {
                       "need more memory than is free");
     animate->add_option("--threads", threads, "Worker threads")->check(CLI::Range(1, 1024));
 
+    // The docs name the examples as $(sweepers-cli examples)/horn.json, so that one command
+    // works in a checkout and after an install.
+    CLI::App* examples = app.add_subcommand(
+        "examples", "Print the folder of the example stroke scripts (data/ in a checkout)");
+
     for (CLI::App* command : app.get_subcommands([](CLI::App*) { return true; })) {
         quietFlag(command);
         limitOptions(command);
@@ -774,6 +779,12 @@ static int run(int argc, char** argv) {
         limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
                                                       std::size_t(threads));
     try {
+        if (*examples) {
+            if (!std::filesystem::is_directory(places.examples))
+                throw FileError("the examples are not installed at " + places.examples);
+            std::cout << places.examples << "\n";
+            return kDone;
+        }
         if (*check) return runCheck(checkArgs);
         if (*info) return runInfo(path, gridName);
         if (*apply) return runApply(applyArgs);

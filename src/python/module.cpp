@@ -14,6 +14,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include "core/install_paths.h"
 #include "core/limits.h"
 #include "io/isolated_read.h"
 #include "io/mesh_file.h"
@@ -595,6 +596,25 @@ PYBIND11_MODULE(sweepers, m) {
             return d;
         },
         "The limits in force: {'max_memory': bytes, 'max_work': voxel updates}.");
+
+    m.def(
+        "examples",
+        [] {
+            // Where the module is, not where the interpreter is: a module installed under a
+            // prefix finds that prefix's examples (the sweepers-cli package's, from Debian).
+            const std::string file =
+                py::module_::import("sweepers").attr("__file__").cast<std::string>();
+            std::string folder = modulePlaces(file).examples;
+            if (!std::filesystem::is_directory(folder)) {
+                const std::string why = "the examples are not installed at " + folder +
+                                        " (Debian: apt install sweepers-cli)";
+                PyErr_SetString(PyExc_FileNotFoundError, why.c_str());
+                throw py::error_already_set();
+            }
+            return folder;
+        },
+        "The folder of the example stroke scripts: the installed ones (the sweepers-cli "
+        "package's) or, for the module in a build tree, the checkout's data/.");
 
     py::class_<Shape> shape(m, "Shape",
                             "A sculpted level set with the history that made it "

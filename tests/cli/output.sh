@@ -88,6 +88,8 @@ grep -qx "Examples: $data (sweepers-cli apply $data/horn.json -o horn.vdb)" "$tm
   fail "--help: $(tail -2 "$tmp/help")"
 grep -qx "Guides: $(dirname "$data")/README.md and docs/ beside it (cli.md, stroke-scripts.md, studies.md)" \
   "$tmp/help" || fail "--help: $(tail -2 "$tmp/help")"
+# `examples` prints the same folder, the one the docs' $(sweepers-cli examples) names.
+[ "$("$cli" examples)" = "$data" ] || fail "examples: $("$cli" examples)"
 "$cli" study "$data/studies/rigid_motion.json" -o "$tmp/js" --voxel-sizes 1/8,1/16 --json \
   >"$tmp/study.json" 2>/dev/null
 json_keys "$tmp/study.json" script dir csv report runs reused failed files

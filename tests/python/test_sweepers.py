@@ -65,6 +65,12 @@ def test_version_is_the_programs():
     assert cli("--version").stdout.split()[-1] == sweepers.__version__
 
 
+def test_examples_are_the_programs():
+    # In the build tree, the checkout's data/, as `sweepers-cli examples` says.
+    assert os.path.samefile(sweepers.examples(), DATA)
+    assert sweepers.examples() == cli("examples").stdout.strip()
+
+
 def test_apply_gives_what_the_cli_writes(twisted):
     shape, report, d = twisted
     assert shape.volume == pytest.approx(report["volume"], rel=1e-12)
