@@ -3,9 +3,10 @@
 # The three packages as a user gets them: a fresh Debian 12 root (debootstrap, minbase),
 # `apt-get install ./sweepers-cli_*.deb` pulling its Depends from Debian's archive and
 # nothing that draws, then the modeler's and the module's packages; each program and the
-# module used from another directory; all three purged without a trace.
-# fresh_root.sh BUILD_DIR. Needs root (chroot) and Debian's archive; exits 77 (skipped)
-# without root.
+# module used from another directory (the modeler drawing on the X server of $DISPLAY); all
+# three purged without a trace.
+# fresh_root.sh BUILD_DIR, under xvfb-run. Needs root (chroot) and Debian's archive; exits 77
+# (skipped) without root.
 set -euo pipefail
 build=$(cd "$1" && pwd)
 fail() { echo "FAIL: $*"; exit 1; }
@@ -67,6 +68,18 @@ in_root "apt-get install -y -qq --no-install-recommends ${others[*]}" >"$tmp/all
 in_root 'sweepers --help | grep -q "^Examples: /usr/share/sweepers/examples " &&
   [ -e /usr/share/sweepers/shaders/clay.frag ] && [ -e /usr/share/man/man1/sweepers.1.gz ]' ||
   fail "the installed modeler does not name its examples"
+# The modeler draws an example with the root's own Mesa, on this machine's X server (its
+# socket is reached by name, the abstract one the root shares).
+if [ -n "${DISPLAY:-}" ]; then
+  [ -n "${XAUTHORITY:-}" ] && cp "$XAUTHORITY" "$root/xauthority"
+  echo '{"events": []}' >"$root/elsewhere/none.json"
+  in_root "cd /elsewhere && DISPLAY=$DISPLAY XAUTHORITY=/xauthority sweepers \
+    /usr/share/sweepers/examples/horn.json --voxel-size 0.05 --size 640x480 --hide-ui \
+    --screenshot shot.png --replay-input none.json" >"$tmp/modeler.log" 2>&1 ||
+    fail "the installed modeler did not draw: $(tail -3 "$tmp/modeler.log")"
+  /usr/bin/python3 "$(dirname "$0")/../app/check_image.py" centred "$root/elsewhere/shot.png" ||
+    fail "the installed modeler's picture shows no clay in the middle"
+fi
 if [ -e "$build/python" ]; then
   in_root "cd /elsewhere && LD_PRELOAD=$preload python3 -c '
 import sweepers
@@ -78,7 +91,7 @@ assert vertices.shape[1] == 3
 '" || fail "the installed Python module did not work"
 fi
 all_size=$(in_root "du -sm /usr | cut -f1")
-echo "all three: /usr $all_size MB; the modeler names its examples, the module sculpts an example"
+echo "all three: /usr $all_size MB; the modeler draws an example, the module sculpts one"
 
 # --- removed without a trace ------------------------------------------------------------
 ours=$(in_root "dpkg -L ${packages[*]}" | sort -u)
