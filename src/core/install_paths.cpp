@@ -15,11 +15,11 @@ ProgramPlaces placesFor(const fs::path& builtIn, const fs::path& where, const fs
     std::error_code ec;
     if (fs::equivalent(where, builtIn, ec))
         return {SWEEPERS_SOURCE_DIR "/data", SWEEPERS_SOURCE_DIR};
-    const fs::path share = prefix / "share";
     // The guides are in the sweepers-cli package (which the modeler's depends on), so one
-    // place serves both programs and the module.
-    return {fs::weakly_canonical(share / "sweepers" / "examples", ec).string(),
-            fs::weakly_canonical(share / "doc" / "sweepers-cli", ec).string()};
+    // place serves both programs and the module. (Both places are CMake's, relative to the
+    // prefix.)
+    return {fs::weakly_canonical(prefix / SWEEPERS_EXAMPLES_DIR, ec).string(),
+            fs::weakly_canonical(prefix / SWEEPERS_GUIDES_DIR, ec).string()};
 }
 
 } // namespace
