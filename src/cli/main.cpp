@@ -208,8 +208,9 @@ int runInfo(const std::string& path, const std::string& gridName) {
                     peer.elsewhereBox.min.y(), peer.elsewhereBox.min.z(), peer.elsewhereBox.max.x(),
                     peer.elsewhereBox.max.y(), peer.elsewhereBox.max.z());
     if (peer.thinVoxels > 0)
-        std::printf("  thin features (two surfaces or a ridge of the distance within 3 voxels, or "
-                    "a crease): %zu voxels next to the surface, in [%g %g %g] - [%g %g %g]\n",
+        std::printf("  thin features (two surfaces or a ridge of the distance within 3 voxels, a "
+                    "crease, or a thinner one across the stencil): %zu voxels next to the "
+                    "surface, in [%g %g %g] - [%g %g %g]\n",
                     peer.thinVoxels, peer.thinBox.min.x(), peer.thinBox.min.y(),
                     peer.thinBox.min.z(), peer.thinBox.max.x(), peer.thinBox.max.y(),
                     peer.thinBox.max.z());

@@ -16,7 +16,11 @@
 // turns by more than 15 degrees from the voxel to a face neighbour, as at a box's edge,
 // where the medial axis meets the surface. The exact distance of an edge fails the test
 // from a turn of about 30 degrees, which the central differences next to it see as half;
-// the same test takes in parts under about four voxels in radius.
+// the same test takes in parts under about four voxels in radius. And where the stencil's row
+// along an axis crosses a sheet or rod under 1.25 voxels thick (along the row, between two
+// crossings, a run whose length times the slope it is crossed with is under that) whose
+// deepest voxel is on such a feature itself: the normal through the voxel may miss what the
+// test reads across, as beside a strangle's squeezed neck.
 #pragma once
 
 #include <cstddef>
