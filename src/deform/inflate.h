@@ -14,17 +14,22 @@
 // sign: the thesis's map is discontinuous there (just inside, the ball is clay and the shape
 // smooth; just outside, it is empty and the pushed surface closes round it in a cusp as thin
 // as a razor). For a centre at depth s inside, the new surface lies about s^3 / (3 rho^2)
-// beyond the ball's edge, where the inverse squeezes a whole band into the centre's
-// neighbourhood (its stretch grows without bound), and the values sampled there are no
+// beyond the ball's edge where the old surface is nearest, and leaves the ball where the
+// old surface is farther, while the inverse squeezes a whole shell into the centre's
+// neighbourhood (its stretch grows without bound): the values sampled there are no
 // distances. So an inflation whose centre's value (as the grid holds it when the inflation
-// comes) lies within the band, either side of the surface, fills its ball
-// (InflationFill): the value inside is the distance to the sphere of radius
-// (rho^3 + s^3)^(1/3) about c, which the new surface encloses and touches where the old
-// surface is nearest (a small fraction of a voxel from the edge), and a value sampled just
-// beyond the edge outside the shape is capped by the distance to that sphere, no smaller than
-// the distance to the new surface. Deeper centres keep the thesis's value. The stroke first
-// puts a centre just outside the surface, within the band, on the surface along the normal
-// (sculpt/stroke.cpp).
+// comes; below the band, the depth found from the surface) lies above -deepestFill() and
+// below the band fills its ball (InflationFill): along the ray from c through x the new
+// surface lies at the image of the old surface's first crossing Q, at radius
+// (rho^3 + Q^3)^(1/3), so a point within a band of the edge, in the ball or beyond it (where
+// the sign agrees), takes its distance along the ray times the cosine between the ray and the
+// surface's normal, the old normal carried through the map. Without a probe of the old
+// surface (the exact reference), Q is bounded by s, and the value inside the ball is the
+// distance to the sphere of radius (rho^3 + s^3)^(1/3) the new surface encloses. Elsewhere
+// beyond the ball a sample is divided by the norm of its gradient carried through the map
+// (carriedValue). Deeper centres keep the thesis's value: the ball is clay a band deep. The
+// stroke first puts a centre just outside the surface, within the band, on the surface along
+// the normal (sculpt/stroke_plan.cpp).
 //
 #pragma once
 
@@ -55,12 +60,21 @@ class Inflation : public StepDeformation {
                               double tolerance = 0.0) const override;
     Eigen::Vector3d filledFrom() const override { return c_; }
     bool fillsWith(double fromValue) const override;
-    double filledValue(const Eigen::Vector3d& x, double value, double fromValue) const override;
-    Box filledBox() const override;
+    double filledValue(const Eigen::Vector3d& x, double value, double fromValue,
+                       const SurfaceProbe* probe) const override;
+    Box filledBox(double fromValue) const override;
+    double deepestFill() const override;
+    Box fillReach() const override;
+    Box carriedReach() const override;
+    double carriedValue(const Eigen::Vector3d& x, double value,
+                        const Eigen::Vector3d& g) const override;
 
   private:
     Eigen::Vector3d blowUp(const Eigen::Vector3d& p) const; // 2.30
     Eigen::Vector3d suckIn(const Eigen::Vector3d& p) const; // 2.31, c inside the ball
+    // J^T g for the inverse's Jacobian J at radius r along the unit n, q its image's radius.
+    static Eigen::Vector3d carried(const Eigen::Vector3d& n, double r, double q,
+                                   const Eigen::Vector3d& g);
     Eigen::Vector3d c_;
     double rho_, rho3_;
     bool remove_;

@@ -32,6 +32,20 @@ struct ForwardResult {
     int iterations = 0; // largest count over the sub-steps
 };
 
+// Where a ray meets the surface of a level set: the least t in [start, most] at which the
+// value at from + t * direction (a unit direction) is no longer negative, and the value's
+// gradient there; t = `most` and a zero gradient where there is none.
+struct SurfaceExit {
+    double t = 0.0;
+    Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
+};
+class SurfaceProbe {
+  public:
+    virtual ~SurfaceProbe() = default;
+    virtual SurfaceExit firstExit(const Eigen::Vector3d& from, const Eigen::Vector3d& direction,
+                                  double start, double most) const = 0;
+};
+
 class StepDeformation {
   public:
     virtual ~StepDeformation() = default;
@@ -114,16 +128,37 @@ class StepDeformation {
     // has one sub-step). Then the value sampled at x, at its pre-image, becomes
     // filledValue(x, value, fromValue), fromValue the value at filledFrom() before the
     // deformation: a distance to the new surface rather than one value across the region.
-    // filledBox() holds every point where filledValue differs from the value it is given;
-    // where fillsWith(fromValue) is false, it differs nowhere.
+    // filledBox(fromValue) holds every point where filledValue differs from the value it is
+    // given; where fillsWith(fromValue) is false, it differs nowhere. Below -deepestFill(),
+    // fillsWith is false: a grid whose values stop short of that depth must find the depth
+    // of filledFrom() below its surface.
     bool fills() const { return fills_; }
     virtual Eigen::Vector3d filledFrom() const { return Eigen::Vector3d::Zero(); }
     virtual bool fillsWith(double /*fromValue*/) const { return false; }
-    virtual double filledValue(const Eigen::Vector3d& /*x*/, double value,
-                               double /*fromValue*/) const {
+    // `probe`, where given, finds where rays from filledFrom() meet the surface as it was
+    // before the deformation (the filled region's value is then the distance along the ray
+    // to that crossing's image); without one, a bound from fromValue alone.
+    virtual double filledValue(const Eigen::Vector3d& /*x*/, double value, double /*fromValue*/,
+                               const SurfaceProbe* /*probe*/) const {
         return value;
     }
-    virtual Box filledBox() const { return {}; }
+    virtual Box filledBox(double /*fromValue*/) const { return {}; }
+    virtual double deepestFill() const { return 0.0; }
+    // A box holding filledBox(v) for every v, and one holding every point where carriedValue
+    // changes a value.
+    virtual Box fillReach() const { return {}; }
+    virtual Box carriedReach() const { return {}; }
+    // A filling deformation squeezes a whole shell around its region into the neighbourhood of
+    // filledFrom(), so a value sampled at x's pre-image y varies across the shell far faster
+    // than the grid resolves: this gives it as a distance at x to first order, from the
+    // value and its gradient g at y (the value over the norm of g carried through the map,
+    // J^T g with J the inverse map's Jacobian at x, times the norm of g), where the map
+    // stretches much; it gives way to the value itself farther out, and outside
+    // carriedReach() is the value itself, as for a deformation that does not fill.
+    virtual double carriedValue(const Eigen::Vector3d& /*x*/, double value,
+                                const Eigen::Vector3d& /*g*/) const {
+        return value;
+    }
 
     double forwardTolerance() const { return forwardTolerance_; }
 

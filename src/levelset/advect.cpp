@@ -673,10 +673,10 @@ void SegmentAdvector::Work::renormalizeChanged() {
     freed = dilatedByCube(changed, int(std::ceil(halfWidth)) + 1);
     freed.insert(freed.end(), fresh.begin(), fresh.end());
     moved.insert(moved.end(), fresh.begin(), fresh.end());
-    const auto pass = [&](Seeding seeding) {
+    const auto pass = [&](Seeding seeding, const VoxelList& only) {
         RenormalizeOptions o;
         o.region = touched;
-        o.only = &freed;
+        o.only = &only;
         o.moved = &moved;
         o.order = options->renormalization;
         o.seeding = seeding;
@@ -686,15 +686,28 @@ void SegmentAdvector::Work::renormalizeChanged() {
         stats.leavesVisited += done.leaves;
         stats.voxelsVisited += done.leaves * LeafNode::SIZE;
     };
-    if (!seg->tears()) {
-        pass(Seeding::Lower);
+    if (!seg->tears() && !seg->fills()) {
+        pass(Seeding::Lower, freed);
         return;
     }
     // A tear's seeds come from a field whose slope varies by orders of magnitude around the
-    // rim: the first pass puts the surface where the tear leaves it, the second seeds the
-    // same voxels from that surface (Seeding says why).
-    pass(Seeding::Either);
-    pass(Seeding::Interface);
+    // rim; an inflation joins the distances found along rays near its ball's edge to the
+    // values carried through its map beyond (inflate.h), at seams the central differences
+    // straddle. The first pass puts the surface where the segment leaves it, the second seeds
+    // the same voxels from that surface (Seeding says why): all of them after a tear, those
+    // within the inflation's fillReach() after an inflation.
+    pass(Seeding::Either, freed);
+    if (seg->tears()) {
+        pass(Seeding::Interface, freed);
+        return;
+    }
+    const openvdb::CoordBBox near =
+        indexBox(*grid, seg->fillReach(), int(std::ceil(halfWidth)) + 1);
+    VoxelList nearFreed;
+    for (const LeafVoxels& leaf : freed)
+        if (near.hasOverlap(openvdb::CoordBBox::createCube(leaf.origin, LeafNode::DIM)))
+            nearFreed.push_back(leaf);
+    pass(Seeding::Interface, nearFreed);
 }
 
 // Sampling changed the band's voxels in `changed` and switched on those of `fresh`;

@@ -84,10 +84,11 @@ std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shel
     const SampleSource source(grid, Grid::create());
     const double from = filledFromValue(source, grid, seg, sampling);
     if (!seg.fillsWith(from)) return 0;
-    const openvdb::CoordBBox box = indexBox(grid, seg.filledBox(), 1);
+    const openvdb::CoordBBox box = indexBox(grid, seg.filledBox(from), 1);
     const auto needed = [&](const Eigen::Vector3d& x, float, const SampleSource::Accessor& acc) {
         const double at = acc.trilinear(grid.worldToIndex(toVdb(seg.inverseMap(x))));
-        const double filled = seg.filledValue(x, at, from);
+        // (The sphere the new surface encloses bounds the depth enough to tell what joins.)
+        const double filled = seg.filledValue(x, at, from, nullptr);
         return filled != at && std::abs(filled) < shell;
     };
     return markInactive(grid, box, needed, mask);

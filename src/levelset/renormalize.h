@@ -58,7 +58,9 @@ enum class UpwindOrder { First = 1, Second = 2 };
 //    second pass over a field that is a distance already: after a tear's first pass its
 //    surface is where the tear put it, but its seeds, estimated from a field whose slope
 //    varies by orders of magnitude within a few voxels, still disagree with one another by a
-//    tenth to a third of a voxel, more than the surface's distance does from voxel to voxel.
+//    tenth to a third of a voxel, more than the surface's distance does from voxel to voxel;
+//    after an inflation's, likewise across the seam where its ball's values meet those carried
+//    through its map.
 enum class Seeding { Lower, Either, Interface };
 
 // What a renormalization recomputes, and how. The defaults renormalize the whole band.

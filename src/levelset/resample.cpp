@@ -14,6 +14,7 @@
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
 
 namespace sweepers {
 
@@ -183,14 +184,91 @@ Resampler::~Resampler() = default;
 Resampler::Resampler(Resampler&&) noexcept = default;
 Resampler& Resampler::operator=(Resampler&&) noexcept = default;
 
+namespace {
+
+// How far p (index space) lies from the surface the values place, in voxels: the distance to
+// the nearest crossing of a voxel edge (linearly placed), or `most` when none is nearer.
+double depthBelowSurface(const SampleSource& source, const openvdb::Vec3d& p, double most) {
+    const openvdb::CoordBBox box(openvdb::Coord::floor(p - openvdb::Vec3d(most)),
+                                 openvdb::Coord::floor(p + openvdb::Vec3d(most)) +
+                                     openvdb::Coord(1));
+    return tbb::parallel_reduce(
+        tbb::blocked_range<int>(box.min().x(), box.max().x() + 1), most,
+        [&](const tbb::blocked_range<int>& xs, double nearest) {
+            const SampleSource::Accessor acc(source);
+            for (int x = xs.begin(); x != xs.end(); ++x)
+                for (int y = box.min().y(); y <= box.max().y(); ++y)
+                    for (int z = box.min().z(); z <= box.max().z(); ++z) {
+                        const openvdb::Coord c(x, y, z);
+                        const float v = acc.getValue(c);
+                        for (int a = 0; a < 3; ++a) {
+                            openvdb::Coord n = c;
+                            ++n[a];
+                            const float w = acc.getValue(n);
+                            if ((v < 0.0f) == (w < 0.0f)) continue;
+                            openvdb::Vec3d at = c.asVec3d();
+                            at[a] += double(v) / (double(v) - double(w));
+                            nearest = std::min(nearest, (at - p).length());
+                        }
+                    }
+            return nearest;
+        },
+        [](double a, double b) { return std::min(a, b); });
+}
+
+} // namespace
+
+SurfaceExit GridProbe::firstExit(const Eigen::Vector3d& from, const Eigen::Vector3d& direction,
+                                 double start, double most) const {
+    // Steps of the value's own size (a distance: no crossing is nearer), a quarter voxel at
+    // least, then the crossing between the last two samples, linearly, and the central
+    // differences there. (A ray that enters the shape within a quarter voxel of `start` is
+    // taken as starting inside: the gap it crossed first is far below what the grid resolves
+    // once the map blows it up.)
+    const auto at = [&](const Eigen::Vector3d& p) {
+        return double(acc_.trilinear(place_.toIndex(toVdb(p))));
+    };
+    const auto exitAt = [&](double t) {
+        SurfaceExit e{t, Eigen::Vector3d::Zero()};
+        const Eigen::Vector3d p = from + t * direction;
+        for (int a = 0; a < 3; ++a) {
+            const Eigen::Vector3d d = h_ * Eigen::Vector3d::Unit(a);
+            e.gradient[a] = (at(p + d) - at(p - d)) / (2.0 * h_);
+        }
+        return e;
+    };
+    double t = start, v = at(from + t * direction);
+    if (v >= 0.0) {
+        // From the surface itself, a ray into the shape meets it again where it leaves.
+        const double in = start + 0.25 * h_, w = at(from + in * direction);
+        if (w >= 0.0) return exitAt(t);
+        t = in;
+        v = w;
+    }
+    while (t < most) {
+        const double next = std::min(most, t + std::max(-v, 0.25 * h_));
+        const double w = at(from + next * direction);
+        if (w >= 0.0) return exitAt(t - v * (next - t) / (w - v));
+        t = next;
+        v = w;
+    }
+    return {most, Eigen::Vector3d::Zero()};
+}
+
 double filledFromValue(const SampleSource& source, const Grid& grid, const StepDeformation& seg,
                        Sampling sampling) {
     const SampleSource::Accessor acc(source);
     const openvdb::Vec3d p = VoxelPlacement(grid.transform()).toIndex(toVdb(seg.filledFrom()));
-    const float reach = float(kCorrectedReach * grid.voxelSize()[0]);
-    return sampling == Sampling::MonotoneCubic ? sampleMonotoneCubic(acc, p)
-           : sampling == Sampling::Corrected   ? acc.corrected(p, reach)
-                                               : acc.trilinear(p);
+    const double h = grid.voxelSize()[0];
+    const float reach = float(kCorrectedReach * h);
+    const double v = sampling == Sampling::MonotoneCubic ? sampleMonotoneCubic(acc, p)
+                     : sampling == Sampling::Corrected   ? acc.corrected(p, reach)
+                                                         : acc.trilinear(p);
+    // Deeper than the band, the values say only that: the depth is found from the surface.
+    if (v > -0.999 * double(grid.background()) || !(seg.deepestFill() > 0.0)) return v;
+    const double most = seg.deepestFill() / h + 1.0;
+    const double depth = depthBelowSurface(source, p, most);
+    return depth < most ? -depth * h : v;
 }
 
 std::size_t Resampler::run(Grid& grid, const std::vector<LeafNode*>& leaves,
@@ -216,12 +294,15 @@ std::size_t Resampler::run(Grid& grid, const std::vector<LeafNode*>& leaves,
         seg && seg->fills() ? filledFromValue(source, grid, *seg, sampling) : 0.0;
     // (Where the fill does not apply, no voxel looks at it.)
     const StepDeformation* filling = seg && seg->fillsWith(fromValue) ? seg : nullptr;
-    const Box filledBox = filling ? filling->filledBox() : Box();
+    const Box filledBox = filling ? filling->filledBox(fromValue) : Box();
     const bool windowPastRim = tearing && tearing->windowPastRim();
     const double h = grid.voxelSize()[0];
+    const float carryBelow = float(0.999 * std::abs(grid.background()));
+    const Box carriedBox = filling ? filling->carriedReach() : Box();
     const float reach = float(kCorrectedReach * h), seedReach = float(kSeedValues * h);
     parallelFor(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const auto& range) {
         const SampleSource::Accessor acc(source);
+        const GridProbe probe(acc, grid.transform());
         ResampleScratch& s = scratch_->threads.local();
         SourceBlock& block = s.block;
         std::size_t n = 0;
@@ -285,7 +366,8 @@ std::size_t Resampler::run(Grid& grid, const std::vector<LeafNode*>& leaves,
                         return block.holds(cell) ? block.trilinear(cell, p - cell.asVec3d())
                                                  : acc.trilinear(p);
                     };
-                    v = sample(y, gradientBefore ? slope : nullptr);
+                    const bool carries = filling && carriedBox.contains(x);
+                    v = sample(y, gradientBefore || carries ? slope : nullptr);
                     if (tearing) {
                         const double depth = tearing->openedDepth(x);
                         if (depth > 0.0 || (windowPastRim && depth > -tornWindow)) {
@@ -302,9 +384,24 @@ std::size_t Resampler::run(Grid& grid, const std::vector<LeafNode*>& leaves,
                         v = std::max(v, float(tearing->leastValue(y))) +
                             float(std::max(0.0, depth));
                     }
+                    if (carries && std::abs(v) < carryBelow) {
+                        // (A value the source holds at its background carries no distance.)
+                        // The gradient at the pre-image: the sample's own central differences
+                        // where it read them, else the samples a voxel either way.
+                        Eigen::Vector3d g;
+                        for (int a = 0; a < 3; ++a) {
+                            const Eigen::Vector3d e = h * Eigen::Vector3d::Unit(a);
+                            g[a] = std::isnan(slope[0])
+                                       ? double(sample(y + e) - sample(y - e)) / (2.0 * h)
+                                       : double(slope[a]) / h;
+                        }
+                        const float carried = float(filling->carriedValue(x, v, g));
+                        madeDistance = carried != v;
+                        v = carried;
+                    }
                     if (filling && filledBox.contains(x)) {
-                        const float filled = float(filling->filledValue(x, v, fromValue));
-                        madeDistance = filled != v;
+                        const float filled = float(filling->filledValue(x, v, fromValue, &probe));
+                        madeDistance = madeDistance || filled != v;
                         v = filled;
                     }
                 }

@@ -242,6 +242,21 @@ class Resampler {
     std::unique_ptr<Scratch> scratch_;
 };
 
+// Where rays meet the surface the source holds (trilinear samples), for a filling
+// deformation's region (StepDeformation::filledValue).
+class GridProbe : public SurfaceProbe {
+  public:
+    GridProbe(const SampleSource::Accessor& acc, const openvdb::math::Transform& transform)
+        : acc_(acc), place_(transform), h_(transform.voxelSize()[0]) {}
+    SurfaceExit firstExit(const Eigen::Vector3d& from, const Eigen::Vector3d& direction,
+                          double start, double most) const override;
+
+  private:
+    const SampleSource::Accessor& acc_;
+    VoxelPlacement place_;
+    double h_;
+};
+
 // The value a filling deformation's region is made from: at its filledFrom(), before the
 // deformation, sampled as `sampling` samples every voxel.
 double filledFromValue(const SampleSource& source, const Grid& grid, const StepDeformation& seg,

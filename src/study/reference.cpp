@@ -74,7 +74,8 @@ std::optional<double> ExactReference::valueAlong(const std::vector<std::size_t>&
     for (std::size_t i = 0; i < steps.size(); ++i) {
         const std::size_t k = steps[i];
         const StepDeformation& seg = *history_[k];
-        if (seg.tears() || (seg.fills() && seg.filledBox().contains(p))) turns.emplace_back(k, p);
+        if (seg.tears() || (seg.fills() && seg.filledBox(fromValues_[k]).contains(p)))
+            turns.emplace_back(k, p);
         p = seg.inverseMap(p);
         if (after && !(*after)[i].contains(p)) return std::nullopt;
     }
@@ -82,7 +83,7 @@ std::optional<double> ExactReference::valueAlong(const std::vector<std::size_t>&
     for (auto it = turns.rbegin(); it != turns.rend(); ++it) {
         const StepDeformation& seg = *history_[it->first];
         if (seg.tears()) v += std::max(0.0, seg.openedDepth(it->second));
-        if (seg.fills()) v = seg.filledValue(it->second, v, fromValues_[it->first]);
+        if (seg.fills()) v = seg.filledValue(it->second, v, fromValues_[it->first], nullptr);
     }
     return v;
 }

@@ -164,18 +164,19 @@ TEST(ExactReference, TheStudysMeasureOfAnExactDistanceIsItsLinearReadingsFloor) 
     EXPECT_NEAR(thirtyTwo / sixteen, 0.5, 0.05);
 }
 
-// The exact reference fills an inflation's ball as the engine does (inflate.h): a centre on
-// the sphere or within the band inside it gives a ball of clay, its value the distance to the
-// sphere of radius (rho^3 + s^3)^(1/3) down to minus the band, s the centre's depth before
-// the inflation (here the second of two, the first far below); a centre deeper inside gives
-// the thesis's value, the centre's, throughout. Just beyond the edge above the sphere lies
-// empty space.
+// The exact reference fills an inflation's ball as the engine does (inflate.h), with the
+// same sign: a centre on the sphere or inside it, down to the depth where the sphere the new
+// surface encloses lies a band beyond the edge, gives a ball of clay, its value the distance
+// to the sphere of radius (rho^3 + s^3)^(1/3) down to minus the band, s the centre's depth
+// before the inflation (here the second of two, the first far below); a centre deeper
+// inside gives the thesis's value, the centre's, throughout.
 TEST(ExactReference, AnInflationOnTheSurfaceFillsItsBallWithClay) {
     const double rho = 0.3, band = 3.0 / 64;
     const Box everywhere(Eigen::Vector3d::Constant(-3), Eigen::Vector3d::Constant(3));
     const Box below(Eigen::Vector3d::Constant(-6), Eigen::Vector3d(6, -4, 6));
     const Eigen::Vector3d c(0, 1, 0);
-    for (const double depth : {0.0, 0.02, 0.1}) {
+    const double outer = rho + band, deepest = std::cbrt(outer * outer * outer - rho * rho * rho);
+    for (const double depth : {0.0, 0.02, 0.1, 0.3}) {
         ExactReference ref(ExactReference::sphere(Eigen::Vector3d(0, depth, 0), 1.0));
         ref.append(std::make_shared<Inflation>(Eigen::Vector3d(0, -5, 0), 0.1, below, false,
                                                InflationFill{band}));
@@ -183,10 +184,12 @@ TEST(ExactReference, AnInflationOnTheSurfaceFillsItsBallWithClay) {
         const double edge = std::cbrt(rho * rho * rho + depth * depth * depth);
         for (const double r : {0.2, 0.5, 0.9}) {
             const Eigen::Vector3d p = c + r * rho * Eigen::Vector3d(0.6, 0.8, 0);
-            const double want = depth < band ? std::max(r * rho - edge, -band) : -depth;
+            const double want = depth < deepest ? std::max(r * rho - edge, -band) : -depth;
             EXPECT_NEAR(ref.value(p), want, 1e-12) << depth << " " << r;
         }
-        EXPECT_GT(ref.value(c + 1.02 * rho * Eigen::Vector3d::UnitY()), 0.0) << depth;
+        // Right above the centre the new surface is that sphere.
+        EXPECT_EQ(ref.value(c + 1.02 * rho * Eigen::Vector3d::UnitY()) > 0.0, 1.02 * rho > edge)
+            << depth;
     }
 }
 
