@@ -81,11 +81,14 @@ double Inflation::filledValue(const Eigen::Vector3d& x, double value, double fro
     bool found = false;
     if (probe && r > 0.0 && r > rho_ - band && r < rho_ + band) {
         const Eigen::Vector3d n = u / r;
+        // (From a hair before s, so that a crossing at s itself is found.)
         const SurfaceExit exit = probe->firstExit(c_, n, std::max(0.0, s - 1e-9), deepestFill());
         crossing = exit.t;
         found = exit.t < deepestFill();
         const Eigen::Vector3d m =
             carried(n, std::cbrt(rho3_ + crossing * crossing * crossing), crossing, exit.gradient);
+        // (A tenth at least: where the ray runs almost along the surface, the distance along
+        // it says little, and the cosine read from a sampled normal less.)
         if (m.norm() > 0.0) cosine = std::clamp(n.dot(m) / m.norm(), 0.1, 1.0);
     }
     const double out = cosine * (r - std::cbrt(rho3_ + crossing * crossing * crossing));
