@@ -74,21 +74,21 @@ int totalThreads(const StudyArgs& a) {
     return int(std::max(1u, std::thread::hardware_concurrency()));
 }
 
-// The plan of the scripts given (checked before anything is written), or the plan already
-// in the directory when none is given.
 // --keep and --half, given, replace what the plan keeps for the runs still to run.
 void applyOutputs(const StudyArgs& a, StudyPlan& plan) {
     if (!a.keep.empty()) {
-        const std::optional<StudyOutputs> kept = parseKept(a.keep); // checked by makePlan
+        const std::optional<StudyOutputs> kept = parseKept(a.keep);
+        if (!kept)
+            throw UsageError("--keep: '" + a.keep + "' is not one of both, grids, meshes, none");
         plan.outputs.grids = kept->grids;
         plan.outputs.meshes = kept->meshes;
     }
     if (a.half) plan.outputs.half = true;
 }
 
+// The plan of the scripts given (checked before anything is written), or the plan already
+// in the directory when none is given.
 StudyPlan makePlan(const StudyArgs& a) {
-    if (!a.keep.empty() && !parseKept(a.keep))
-        throw UsageError("--keep: '" + a.keep + "' is not one of both, grids, meshes, none");
     if (a.scripts.empty()) {
         if (!std::filesystem::exists(a.dir + "/plan.json"))
             throw UsageError("study: no script given, and " + a.dir +
