@@ -121,6 +121,7 @@ struct SegmentAdvector::Work {
     const AdvectOptions* options = nullptr;
     AdvectStats stats;
     double h = 0.0, halfWidth = 0.0, forwardTolerance = 0.0, tornWindow = 0.0;
+    double filledFrom = 0.0; // what a filling segment fills from (filledFromValue)
     openvdb::CoordBBox region, touched;
     bool measureStretch = false;
     int bandReach = 0, reach = 0;
@@ -158,6 +159,7 @@ struct SegmentAdvector::Work {
         forwardTolerance = 0.01 * h / (1.0 + s.affectedBox().max.cwiseAbs().maxCoeff());
         tornWindow = (std::ceil(halfWidth) + 1) * h; // see resample
         bandReach = int(std::ceil(halfWidth)) + 1;
+        filledFrom = s.fills() ? filledFromValue(g, s, o.sampling) : 0.0;
         widened.reset();
         for (VoxelList* list : {&images, &mask, &fresh, &changed, &moved, &freed})
             list->clear();
@@ -483,7 +485,7 @@ void SegmentAdvector::Work::growBand() {
     if (seg->tears()) stats.tornVoxels = markOpened(*grid, *seg, (halfWidth + 2) * h, mask);
     // An inflation fills its ball: no image of the surface reaches its edge either.
     if (seg->fills())
-        stats.filledVoxels = markFilled(*grid, *seg, (halfWidth + 2) * h, options->sampling, mask);
+        stats.filledVoxels = markFilled(*grid, *seg, (halfWidth + 2) * h, filledFrom, mask);
     fresh = switchOn(mask);
 }
 
@@ -545,6 +547,7 @@ ResamplePlan SegmentAdvector::Work::plan(const LeafMap& map) const {
     p.sampling = options->sampling;
     p.sourceIsGrid = !widened;
     p.tearsOrFills = seg->tears() || seg->fills() ? seg : nullptr;
+    p.filledFrom = filledFrom;
     p.tornWindow = tornWindow;
     p.interrupter = options->interrupter;
     return p;

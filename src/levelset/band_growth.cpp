@@ -79,11 +79,12 @@ std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shel
     return markInactive(grid, box, needed, mask);
 }
 
-std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shell,
-                       Sampling sampling, VoxelList& mask) {
-    const SampleSource source(grid, Grid::create());
-    const double from = filledFromValue(source, grid, seg, sampling);
-    if (!seg.fillsWith(from)) return 0;
+std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shell, double from,
+                       VoxelList& mask) {
+    // A centre deeper than the shell leaves the ball enclosed by the images of the old
+    // surface, which the band already grew around: walking its box (the ball's, voxel by
+    // voxel) would add nothing.
+    if (!seg.fillsWith(from) || from < -shell) return 0;
     const openvdb::CoordBBox box = indexBox(grid, seg.filledBox(from), 1);
     const auto needed = [&](const Eigen::Vector3d& x, float, const SampleSource::Accessor& acc) {
         const double at = acc.trilinear(grid.worldToIndex(toVdb(seg.inverseMap(x))));

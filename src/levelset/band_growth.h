@@ -32,10 +32,12 @@ std::size_t markOpened(const Grid& grid, const StepDeformation& seg, double shel
 // grown around the images of the surface: no surface maps into the region it fills, whose
 // edge may be new surface. The voxels there whose filled value lies within `shell` of the
 // surface join the band; they enclose the rest of the region, whose signs the flood after
-// sampling re-derives. Nothing is marked where the fill does not apply (a dab of clay well
-// inside the shape, as the modeler places it): its ball's box is not walked.
-std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shell,
-                       Sampling sampling, VoxelList& mask);
+// sampling re-derives. Nothing is marked where the fill does not apply or the centre lies
+// deeper than `shell` (a dab of clay well inside the shape, as the modeler places it): its
+// ball's box is not walked.
+// `fromValue` is filledFromValue's.
+std::size_t markFilled(const Grid& grid, const StepDeformation& seg, double shell, double fromValue,
+                       VoxelList& mask);
 
 // Whether sampling reached every voxel renormalization seeds from and every voxel their
 // gradients read: each voxel of `box` in `leaves` next to the zero crossing is active, and

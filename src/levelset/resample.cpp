@@ -186,34 +186,37 @@ Resampler& Resampler::operator=(Resampler&&) noexcept = default;
 
 namespace {
 
-// How far p (index space) lies from the surface the values place, in voxels: the distance to
-// the nearest crossing of a voxel edge (linearly placed), or `most` when none is nearer.
-double depthBelowSurface(const SampleSource& source, const openvdb::Vec3d& p, double most) {
+// How far p (index space) lies from the surface the grid's values place, in voxels: the
+// distance to the nearest crossing of an edge between active voxels (linearly placed), or
+// `most` when none is nearer. Only the leaves within `most` of p are read.
+double depthBelowSurface(const Grid& grid, const openvdb::Vec3d& p, double most) {
     const openvdb::CoordBBox box(openvdb::Coord::floor(p - openvdb::Vec3d(most)),
                                  openvdb::Coord::floor(p + openvdb::Vec3d(most)) +
                                      openvdb::Coord(1));
+    std::vector<const LeafNode*> near;
+    for (auto leaf = grid.tree().cbeginLeaf(); leaf; ++leaf)
+        if (box.hasOverlap(leaf->getNodeBoundingBox())) near.push_back(leaf.getLeaf());
     return tbb::parallel_reduce(
-        tbb::blocked_range<int>(box.min().x(), box.max().x() + 1), most,
-        [&](const tbb::blocked_range<int>& xs, double nearest) {
-            const SampleSource::Accessor acc(source);
-            for (int x = xs.begin(); x != xs.end(); ++x)
-                for (int y = box.min().y(); y <= box.max().y(); ++y)
-                    for (int z = box.min().z(); z <= box.max().z(); ++z) {
-                        const openvdb::Coord c(x, y, z);
-                        const float v = acc.getValue(c);
-                        for (int a = 0; a < 3; ++a) {
-                            openvdb::Coord n = c;
-                            ++n[a];
-                            const float w = acc.getValue(n);
-                            if ((v < 0.0f) == (w < 0.0f)) continue;
-                            openvdb::Vec3d at = c.asVec3d();
-                            at[a] += double(v) / (double(v) - double(w));
-                            nearest = std::min(nearest, (at - p).length());
-                        }
+        tbb::blocked_range<std::size_t>(0, near.size()), most,
+        [&](const tbb::blocked_range<std::size_t>& r, double nearest) {
+            const Grid::ConstAccessor acc = grid.getConstAccessor();
+            for (std::size_t l = r.begin(); l != r.end(); ++l)
+                for (auto it = near[l]->cbeginValueOn(); it; ++it) {
+                    const openvdb::Coord c = it.getCoord();
+                    const float v = *it;
+                    for (int a = 0; a < 3; ++a) {
+                        openvdb::Coord n = c;
+                        ++n[a];
+                        const float w = acc.getValue(n);
+                        if ((v < 0.0f) == (w < 0.0f)) continue;
+                        openvdb::Vec3d at = c.asVec3d();
+                        at[a] += double(v) / (double(v) - double(w));
+                        nearest = std::min(nearest, (at - p).length());
                     }
+                }
             return nearest;
         },
-        [](double a, double b) { return std::min(a, b); });
+        [](double x, double y) { return std::min(x, y); });
 }
 
 } // namespace
@@ -255,8 +258,8 @@ SurfaceExit GridProbe::firstExit(const Eigen::Vector3d& from, const Eigen::Vecto
     return {most, Eigen::Vector3d::Zero()};
 }
 
-double filledFromValue(const SampleSource& source, const Grid& grid, const StepDeformation& seg,
-                       Sampling sampling) {
+double filledFromValue(const Grid& grid, const StepDeformation& seg, Sampling sampling) {
+    const SampleSource source(grid, Grid::create());
     const SampleSource::Accessor acc(source);
     const openvdb::Vec3d p = VoxelPlacement(grid.transform()).toIndex(toVdb(seg.filledFrom()));
     const double h = grid.voxelSize()[0];
@@ -267,7 +270,7 @@ double filledFromValue(const SampleSource& source, const Grid& grid, const StepD
     // Deeper than the band, the values say only that: the depth is found from the surface.
     if (v > -0.999 * double(grid.background()) || !(seg.deepestFill() > 0.0)) return v;
     const double most = seg.deepestFill() / h + 1.0;
-    const double depth = depthBelowSurface(source, p, most);
+    const double depth = depthBelowSurface(grid, p, most);
     return depth < most ? -depth * h : v;
 }
 
@@ -290,8 +293,7 @@ std::size_t Resampler::run(Grid& grid, const std::vector<LeafNode*>& leaves,
     std::atomic<std::size_t> count{0};
     const VoxelPlacement place(grid.transform());
     const StepDeformation* tearing = seg && seg->tears() ? seg : nullptr;
-    const double fromValue =
-        seg && seg->fills() ? filledFromValue(source, grid, *seg, sampling) : 0.0;
+    const double fromValue = plan.filledFrom;
     // (Where the fill does not apply, no voxel looks at it.)
     const StepDeformation* filling = seg && seg->fillsWith(fromValue) ? seg : nullptr;
     const Box filledBox = filling ? filling->filledBox(fromValue) : Box();

@@ -202,8 +202,9 @@ struct ResamplePlan {
     // set by orders of magnitude, would spread that over the rim of the hole.
     //
     // A deformation that fills what has no pre-image (fills(): an inflation's ball) turns the
-    // value sampled there into its filled value (filledFromValue).
+    // value sampled there into its filled value, from `filledFrom`.
     const StepDeformation* tearsOrFills = nullptr;
+    double filledFrom = 0.0; // filledFromValue, where tearsOrFills fills
     double tornWindow = 0.0; // world units
     Interrupter* interrupter = nullptr;
 };
@@ -257,9 +258,10 @@ class GridProbe : public SurfaceProbe {
     double h_;
 };
 
-// The value a filling deformation's region is made from: at its filledFrom(), before the
-// deformation, sampled as `sampling` samples every voxel.
-double filledFromValue(const SampleSource& source, const Grid& grid, const StepDeformation& seg,
-                       Sampling sampling);
+// The value a filling deformation's region is made from: at its filledFrom(), on the grid
+// before the deformation, sampled as `sampling` samples every voxel; deeper than the band,
+// minus the distance to the surface the grid's crossings place (down to deepestFill()).
+// Found once a segment (ResamplePlan::filledFrom).
+double filledFromValue(const Grid& grid, const StepDeformation& seg, Sampling sampling);
 
 } // namespace sweepers
